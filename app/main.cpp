@@ -1,0 +1,414 @@
+// demmat: the suite's command-line program. Every error is one line on stderr and a non-zero exit;
+// every output file is written whole or not at all.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iostream>
+#include <map>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+#include <unistd.h>
+
+#include "demmat/checker.hpp"
+#include "demmat/driver.hpp"
+#include "demmat/error.hpp"
+#include "demmat/io.hpp"
+#include "demmat/output.hpp"
+#include "demmat/registry.hpp"
+#include "demmat/scenes.hpp"
+
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+using namespace demmat;
+
+namespace {
+
+struct Loaded {
+    Scene scene;
+    State state;
+    Setup setup;
+};
+
+// Scene, initial state and setup, validated; the Setup points into the other two, so it lives with them.
+std::unique_ptr<Loaded> load(const std::string& file, bool allow_unstable)
+{
+    auto l = std::make_unique<Loaded>();
+    l->scene = load_scene(file);
+    l->state = initial_state(l->scene);
+    if (!allow_unstable) {
+        const std::string warning = check_time_step(l->scene, l->state);
+        if (!warning.empty()) std::cerr << "demmat: warning: " << warning << "\n";
+    }
+    l->setup = Setup::make(l->scene, l->state);
+    return l;
+}
+
+std::int64_t steps_for(const Scene& scene, std::int64_t steps, double time)
+{
+    if (time > 0.0) return std::int64_t(std::ceil(time / scene.dt - 1e-9));  // integer steps, never accumulated time
+    return steps;
+}
+
+std::vector<std::string> variant_list(const std::string& spec)
+{
+    if (spec == "all") return registry().names();
+    std::vector<std::string> out;
+    std::string cur;
+    for (char c : spec + ",") {
+        if (c == ',') {
+            if (!cur.empty()) out.push_back(registry().find(cur).name);
+            cur.clear();
+        } else {
+            cur += c;
+        }
+    }
+    if (out.empty()) throw Error("no variant named in --variants");
+    return out;
+}
+
+json phase_json(const PhaseTimes& t, std::int64_t steps)
+{
+    const double k = steps > 0 ? 1.0 / double(steps) : 0.0;
+    return {{"predict", t.predict * k}, {"search", t.search * k}, {"forces", t.forces * k}, {"correct", t.correct * k},
+            {"search_plus_forces", (t.search + t.forces) * k}, {"total", t.total() * k}};
+}
+
+json scene_json(const Loaded& l)
+{
+    const Scene& s = l.scene;
+    return {{"name", s.name},
+            {"file", s.source.string()},
+            {"particles", l.state.size()},
+            {"dt", s.dt},
+            {"start_step", l.state.step},
+            {"search", s.search.method == SearchMethod::cells ? "cells" : "all_pairs"},
+            {"cell_size_rmax", s.search.method == SearchMethod::cells ? s.search.cell_size : 0.0},
+            {"cell_size_m", l.setup.cell_size}};
+}
+
+// ---- demmat run ------------------------------------------------------------------------------------
+struct RunArgs {
+    std::string scene, variant = "arrays", json_file, save_file, vtk_dir;
+    std::int64_t steps = 1000, vtk_every = 0;
+    double time = 0.0;
+    bool quiet = false, allow_unstable = false;
+};
+
+int cmd_run(const RunArgs& a)
+{
+    auto l = load(a.scene, a.allow_unstable);
+    const VariantInfo& info = registry().find(a.variant);
+    const std::int64_t steps = steps_for(l->scene, a.steps, a.time);
+    auto variant = info.create();
+    Driver driver(*variant, l->setup);
+
+    std::unique_ptr<VtkSeries> vtk;
+    Snapshot snap;
+    auto write_vtk = [&] {
+        variant->snapshot(snap);
+        vtk->write(snap, l->state.radius, driver.time());
+    };
+    if (!a.vtk_dir.empty()) {
+        vtk = std::make_unique<VtkSeries>(a.vtk_dir, l->scene.name);
+        write_vtk();
+    }
+    if (!a.quiet)
+        std::cerr << fmt::format("demmat: {} on '{}': {} particles, {} walls, {} steps of {:g} s from step {}\n", info.name,
+                                 l->scene.name, l->state.size(), l->state.walls.size(), steps, l->scene.dt, l->state.step);
+
+    using clock = std::chrono::steady_clock;
+    const auto start = clock::now();
+    auto last = start;
+    const bool tty = isatty(STDERR_FILENO);
+    const int interval = l->scene.checks.interval;
+    for (std::int64_t k = 1; k <= steps; ++k) {
+        driver.step();
+        if (interval > 0 && (k % interval == 0 || k == steps)) driver.check_health();
+        if (vtk && a.vtk_every > 0 && (k % a.vtk_every == 0 || k == steps)) write_vtk();
+        if (!a.quiet && (k & 63) == 0) {
+            const auto now = clock::now();
+            if (now - last > std::chrono::seconds(tty ? 1 : 10)) {
+                last = now;
+                const double el = std::chrono::duration<double>(now - start).count();
+                std::cerr << fmt::format("{}step {}/{} ({:.0f}%), t = {:.4g} s, {:.0f} s elapsed, about {:.0f} s left{}",
+                                         tty ? "\r" : "", k, steps, 100.0 * double(k) / double(steps), driver.time(), el,
+                                         el / double(k) * double(steps - k), tty ? "   " : "\n");
+            }
+        }
+    }
+    const double wall = std::chrono::duration<double>(clock::now() - start).count();
+    if (!a.quiet && tty) std::cerr << "\r" << std::string(78, ' ') << "\r";
+
+    variant->snapshot(snap);
+    const ContactCounts c = variant->counts();
+    const double n = double(l->state.size());
+    const double ke = kinetic_energy(snap, l->setup);
+    const PhaseTimes& t = driver.times();
+    const double per = 1.0 / double(std::max<std::int64_t>(1, steps));
+    std::cout << fmt::format("variant {}  scene {}  particles {}  steps {}  t = {:.6g} s\n", info.name, l->scene.name,
+                             l->state.size(), steps, driver.time());
+    std::cout << fmt::format("steps per second {:.1f}  ({:.4f} us per particle-step)\n", double(steps) / t.total(),
+                             t.total() * per / n * 1e6);
+    std::cout << fmt::format("per step: predict {:.3e} s  search {:.3e} s  forces {:.3e} s  correct {:.3e} s  total {:.3e} s\n",
+                             t.predict * per, t.search * per, t.forces * per, t.correct * per, t.total() * per);
+    std::cout << fmt::format("contacts per particle {:.3f} (particle-particle {}, particle-wall {})  kinetic energy {:.6e} J\n",
+                             (2.0 * double(c.particle_particle) + double(c.particle_wall)) / n, c.particle_particle,
+                             c.particle_wall, ke);
+    std::cout << fmt::format("PERFORMANCE variant={} particles={} steps={} us_per_particle_step={:.5f} seconds={:.4f}\n",
+                             info.name, l->state.size(), steps, t.total() * per / n * 1e6, wall);
+
+    if (!a.save_file.empty()) {
+        State out;
+        variant->save(out);
+        out.dt = l->scene.dt;
+        out.fingerprint = l->state.fingerprint;
+        save_state(out, a.save_file);
+    }
+    if (!a.json_file.empty()) {
+        json j = {{"provenance", provenance_json()},
+                  {"scene", scene_json(*l)},
+                  {"variant", info.name},
+                  {"steps", steps},
+                  {"end_time", driver.time()},
+                  {"wall_seconds", wall},
+                  {"steps_per_second", double(steps) / t.total()},
+                  {"us_per_particle_step", t.total() * per / n * 1e6},
+                  {"seconds_per_step", phase_json(t, steps)},
+                  {"contacts", {{"particle_particle", c.particle_particle}, {"particle_wall", c.particle_wall},
+                                {"per_particle", (2.0 * double(c.particle_particle) + double(c.particle_wall)) / n}}},
+                  {"kinetic_energy", ke},
+                  {"memory_bytes", variant->memory_bytes()}};
+        write_atomically(a.json_file, j.dump(2) + "\n");
+    }
+    return 0;
+}
+
+// ---- demmat compare ----------------------------------------------------------------------------------
+int cmd_compare(const std::string& scene, const std::string& variants, std::int64_t steps, double time, bool allow_unstable)
+{
+    auto l = load(scene, allow_unstable);
+    const auto names = variant_list(variants);
+    if (names.size() < 2) throw Error("compare needs at least two variants");
+    const std::int64_t k = steps_for(l->scene, steps, time);
+    const CompareReport r = compare_variants(names, l->setup, k);
+    if (r.difference) {
+        std::cout << "differ: " << r.difference->describe() << "\n";
+        return 1;
+    }
+    std::cout << fmt::format("identical: {} over {} steps of '{}' ({} particles)\n", fmt::join(names, ", "), r.steps,
+                             l->scene.name, l->state.size());
+    return 0;
+}
+
+// ---- demmat bench --------------------------------------------------------------------------------------
+struct BenchArgs {
+    std::string scene, variants = "all", json_file;
+    std::int64_t steps = 200, repetitions = 5, warmup = 20;
+    bool allow_unstable = false;
+};
+
+double median(std::vector<double> v)
+{
+    std::sort(v.begin(), v.end());
+    const std::size_t m = v.size() / 2;
+    return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
+}
+
+int cmd_bench(const BenchArgs& a)
+{
+    auto l = load(a.scene, a.allow_unstable);
+    const auto names = variant_list(a.variants);
+    const char* phases[] = {"predict", "search", "forces", "correct"};
+    // samples[variant][phase] = seconds per step, one per repetition
+    std::map<std::string, std::map<std::string, std::vector<double>>> samples;
+    std::map<std::string, ContactCounts> counts;
+    std::map<std::string, std::size_t> memory;
+    json reps = json::array();
+    for (std::int64_t r = 0; r < a.repetitions; ++r) {
+        // Interleaved, with the order rotated each repetition, so drift of a shared machine hits all alike.
+        for (std::size_t q = 0; q < names.size(); ++q) {
+            const std::string& name = names[(q + std::size_t(r)) % names.size()];
+            auto variant = registry().find(name).create();
+            Driver driver(*variant, l->setup);
+            for (std::int64_t k = 0; k < a.warmup; ++k) driver.step();
+            const PhaseTimes before = driver.times();
+            driver.run(a.steps);
+            const PhaseTimes& after = driver.times();
+            const double per = 1.0 / double(a.steps);
+            const double v[4] = {(after.predict - before.predict) * per, (after.search - before.search) * per,
+                                 (after.forces - before.forces) * per, (after.correct - before.correct) * per};
+            for (int p = 0; p < 4; ++p) {
+                samples[name][phases[p]].push_back(v[p]);
+                reps.push_back({{"variant", name}, {"repetition", r}, {"phase", phases[p]}, {"seconds_per_step", v[p]}});
+            }
+            counts[name] = variant->counts();
+            memory[name] = variant->memory_bytes();
+        }
+        std::cerr << fmt::format("demmat bench: repetition {}/{} done\n", r + 1, a.repetitions);
+    }
+    json summary = json::array();
+    const double n = double(l->state.size());
+    std::cout << fmt::format("{:<16} {:>12} {:>12} {:>12} {:>12} {:>12} {:>10}\n", "variant", "predict", "search", "forces",
+                             "correct", "total", "us/p-step");
+    for (const auto& name : names) {
+        json ph;
+        double total = 0.0;
+        std::vector<double> totals(std::size_t(a.repetitions), 0.0);
+        for (const char* p : phases) {
+            const auto& s = samples[name][p];
+            ph[p] = {{"median", median(s)}, {"min", *std::min_element(s.begin(), s.end())}, {"max", *std::max_element(s.begin(), s.end())}};
+            total += median(s);
+            for (std::size_t r = 0; r < s.size(); ++r) totals[r] += s[r];
+        }
+        const double tot_med = median(totals);
+        ph["total"] = {{"median", tot_med}, {"min", *std::min_element(totals.begin(), totals.end())},
+                       {"max", *std::max_element(totals.begin(), totals.end())}};
+        const ContactCounts& c = counts[name];
+        summary.push_back({{"variant", name},
+                           {"seconds_per_step", ph},
+                           {"us_per_particle_step", tot_med / n * 1e6},
+                           {"contacts_per_particle", (2.0 * double(c.particle_particle) + double(c.particle_wall)) / n},
+                           {"memory_bytes", memory[name]}});
+        std::cout << fmt::format("{:<16} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e} {:>10.4f}\n", name,
+                                 ph["predict"]["median"].get<double>(), ph["search"]["median"].get<double>(),
+                                 ph["forces"]["median"].get<double>(), ph["correct"]["median"].get<double>(), tot_med,
+                                 tot_med / n * 1e6);
+    }
+    std::cout << "(seconds per step, medians over " << a.repetitions << " interleaved repetitions of " << a.steps << " steps)\n";
+    if (!a.json_file.empty()) {
+        json j = {{"provenance", provenance_json()},
+                  {"scene", scene_json(*l)},
+                  {"steps", a.steps},
+                  {"warmup_steps", a.warmup},
+                  {"repetitions", a.repetitions},
+                  {"summary", summary},
+                  {"samples", reps}};
+        write_atomically(a.json_file, j.dump(2) + "\n");
+    }
+    return 0;
+}
+
+// ---- demmat scene ----------------------------------------------------------------------------------------
+struct SceneArgs {
+    std::string kind, out, from, state;
+    std::int64_t count = 0;
+    std::uint64_t seed = 1;
+    double speed = -1.0, gap = 0.001;
+};
+
+int cmd_scene(const SceneArgs& a)
+{
+    Scene s;
+    if (a.kind == "paper") s = paper_scene(a.count > 0 ? a.count : 1000, a.seed);
+    else if (a.kind == "dense-bed") s = dense_bed_scene(a.count > 0 ? a.count : 2000, a.seed);
+    else if (a.kind == "head-on") s = head_on_scene(a.speed >= 0.0 ? a.speed : 1.0);
+    else if (a.kind == "drop") s = drop_scene(a.gap);
+    else if (a.kind == "compression") {
+        if (a.from.empty() || a.state.empty()) throw Error("scene compression needs --from SCENE and --state STATE");
+        const Scene base = load_scene(a.from);
+        fs::path state = a.state;
+        if (!a.out.empty()) {  // keep the state path relative to the new scene file, so the pair can move together
+            std::error_code ec;
+            const fs::path rel = fs::relative(fs::absolute(state), fs::absolute(fs::path(a.out)).parent_path(), ec);
+            if (!ec && !rel.empty()) state = rel;
+        }
+        s = compression_scene(base, state, a.speed >= 0.0 ? a.speed : 0.5);
+    } else {
+        throw Error(fmt::format("unknown scene kind '{}' (expected paper, dense-bed, compression, head-on or drop)", a.kind));
+    }
+    const std::string text = scene_to_toml(s);
+    if (a.out.empty()) std::cout << text;
+    else write_atomically(a.out, text);
+    return 0;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    CLI::App app{"demmat: the DEMMAT discrete element benchmark suite (variants of one DEM processor for spheres)"};
+    app.require_subcommand(1);
+    app.set_help_all_flag("--help-all", "Help for every subcommand");
+
+    auto* list = app.add_subcommand("list", "List the registered variants, one per line, name first");
+
+    SceneArgs sa;
+    auto* scene = app.add_subcommand("scene", "Write a standard scene as an editable TOML file (to stdout without --out)");
+    scene->add_option("kind", sa.kind, "paper | dense-bed | compression | head-on | drop")->required();
+    scene->add_option("--out,-o", sa.out, "Output file");
+    scene->add_option("--n", sa.count, "Number of particles (paper: 1000, dense-bed: 2000)");
+    scene->add_option("--seed", sa.seed, "Seed of the particle generator");
+    scene->add_option("--speed", sa.speed, "head-on: relative speed (m/s); compression: wall speed (m/s)");
+    scene->add_option("--gap", sa.gap, "drop: initial gap between the sphere and the wall (m)");
+    scene->add_option("--from", sa.from, "compression: the scene that was settled");
+    scene->add_option("--state", sa.state, "compression: the settled state file");
+
+    RunArgs ra;
+    auto* run = app.add_subcommand("run", "Run a scene with one variant and report per-phase times");
+    run->add_option("scene", ra.scene, "Scene file (TOML)")->required();
+    run->add_option("--variant,-v", ra.variant, "Variant name (see demmat list)");
+    auto* steps_opt = run->add_option("--steps,-n", ra.steps, "Number of steps");
+    run->add_option("--time,-t", ra.time, "Simulated time (s), instead of --steps")->excludes(steps_opt);
+    run->add_option("--json", ra.json_file, "Write the summary as JSON with provenance");
+    run->add_option("--save", ra.save_file, "Save the final state (continue with particles.source = \"state\")");
+    run->add_option("--vtk", ra.vtk_dir, "Write VTK snapshots and a .pvd series (ParaView) into this folder");
+    run->add_option("--vtk-every", ra.vtk_every, "Steps between VTK snapshots (0: first and last only)");
+    run->add_flag("--quiet,-q", ra.quiet, "No progress on stderr");
+    run->add_flag("--allow-unstable", ra.allow_unstable, "Silence the time-step warning");
+
+    std::string cmp_scene, cmp_variants = "all";
+    std::int64_t cmp_steps = 100;
+    double cmp_time = 0.0;
+    bool cmp_allow = false;
+    auto* compare = app.add_subcommand("compare", "Run variants side by side and check that every step is bit-identical");
+    compare->add_option("scene", cmp_scene, "Scene file (TOML)")->required();
+    compare->add_option("--variants", cmp_variants, "Comma-separated variant names, or all");
+    auto* cmp_steps_opt = compare->add_option("--steps,-n", cmp_steps, "Number of steps");
+    compare->add_option("--time,-t", cmp_time, "Simulated time (s), instead of --steps")->excludes(cmp_steps_opt);
+    compare->add_flag("--allow-unstable", cmp_allow, "Silence the time-step warning");
+
+    BenchArgs ba;
+    auto* bench = app.add_subcommand("bench", "Time variants per phase: interleaved repetitions, medians and spread");
+    bench->add_option("scene", ba.scene, "Scene file (TOML)")->required();
+    bench->add_option("--variants", ba.variants, "Comma-separated variant names, or all");
+    bench->add_option("--steps,-n", ba.steps, "Timed steps per repetition")->check(CLI::PositiveNumber);
+    bench->add_option("--repetitions,-r", ba.repetitions, "Repetitions")->check(CLI::PositiveNumber);
+    bench->add_option("--warmup", ba.warmup, "Untimed steps before each repetition")->check(CLI::NonNegativeNumber);
+    bench->add_option("--json", ba.json_file, "Write the samples and medians as JSON with provenance");
+    bench->add_flag("--allow-unstable", ba.allow_unstable, "Silence the time-step warning");
+
+    try {
+        app.parse(argc, argv);
+    } catch (const CLI::CallForHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::ParseError& e) {
+        std::cerr << "demmat: error: " << e.what() << " (see demmat --help)\n";
+        return 2;
+    }
+
+    try {
+        if (*list) {
+            for (const auto& v : registry().all()) std::cout << fmt::format("{:<16} {}\n", v.name, v.summary);
+            return 0;
+        }
+        if (*scene) return cmd_scene(sa);
+        if (*run) return cmd_run(ra);
+        if (*compare) return cmd_compare(cmp_scene, cmp_variants, cmp_steps, cmp_time, cmp_allow);
+        if (*bench) return cmd_bench(ba);
+    } catch (const InstabilityError& e) {
+        std::cerr << "demmat: run stopped: " << e.what() << "\n";
+        return 3;
+    } catch (const Error& e) {
+        std::cerr << "demmat: error: " << e.what() << "\n";
+        return 2;
+    } catch (const std::exception& e) {
+        std::cerr << "demmat: internal error: " << e.what() << "\n";
+        return 70;
+    }
+    return 0;
+}

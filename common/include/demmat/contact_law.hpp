@@ -1,0 +1,139 @@
+#pragma once
+// The contact law of physics.md §2, written once. Every variant (and every port to another language)
+// computes a contact through these functions, operation for operation, so trajectories agree bit for
+// bit. Changing an expression here changes every variant's trajectory at once, as it should.
+#include <algorithm>
+#include <cmath>
+
+#include "demmat/model.hpp"
+#include "demmat/vec3.hpp"
+
+namespace demmat {
+
+// Per-run constants of the contact law, derived once from the materials (see material.hpp).
+template <class T>
+struct ContactParams {
+    T hertz_pp{};  // (4/3)·E* for particle–particle contacts
+    T hertz_pw{};  // (4/3)·E* for particle–wall contacts
+    T gamma_n{};   // normal damping, 1/s; the term is gamma_n·m*·u_n (Schäfer–Dippel–Wolf form)
+    T gamma_t{};   // tangential viscous coefficient, 1/s
+    T mu{};        // Coulomb friction coefficient
+
+    template <class U>
+    ContactParams<U> as() const
+    {
+        return {U(hertz_pp), U(hertz_pw), U(gamma_n), U(gamma_t), U(mu)};
+    }
+};
+
+// What one contact contributes: force on i (the force on j is exactly -f_i), torque on i and on j.
+template <class T>
+struct ContactForce {
+    Vec3<T> f_i;
+    Vec3<T> t_i;
+    Vec3<T> t_j;
+    T overlap{};
+};
+
+// Cheap, conservative pre-test used by contact searches: true for every pair the law can find in
+// contact (h > 0), and for a few that it will reject. The relative margin 1e-9 covers the rounding of
+// d2 and sqrt (about 1e-16 relative), so any search that keeps the pairs this accepts hands the law a
+// superset of the contact set, and the law alone decides; the trajectory then cannot depend on the
+// search method.
+template <class T>
+inline bool may_touch(const Vec3<T>& xi, const Vec3<T>& xj, T ri, T rj)
+{
+    const Vec3<T> dx = xj - xi;
+    const T d2 = dot(dx, dx);
+    const T s = ri + rj;
+    return d2 < s * s * T(1.000000001);
+}
+
+template <class T>
+inline bool may_touch_wall(const Vec3<T>& xi, T ri, const Vec3<T>& point, const Vec3<T>& normal)
+{
+    // The law tests ri - s > 0 with exactly this s; the margin only makes the list a superset.
+    return dot(xi - point, normal) < ri * T(1.000000001);
+}
+
+namespace detail {
+
+// Normal and tangential force from the contact geometry (n from i towards the partner, overlap h > 0,
+// lever arm d_i, relative velocity u of i with respect to the partner at the contact point).
+template <class M, class T>
+inline void contact_force(const Vec3<T>& n, T h, const Vec3<T>& u, T rstar, T mstar, T hertz,
+                          const ContactParams<T>& p, Vec3<T>& f_i, Vec3<T>& f_t)
+{
+    // h^(3/2) as h·sqrt(h): sqrt is correctly rounded in every language, pow is not (physics.md §6).
+    T fn = hertz * std::sqrt(rstar) * h * std::sqrt(h);
+    T un{};
+    if constexpr (M::damping || M::friction) un = dot(u, n);
+    if constexpr (M::damping) fn = fn + p.gamma_n * mstar * un;
+    if (fn < T(0)) fn = T(0);  // choice: no attraction at the end of a contact
+    f_t = Vec3<T>{};
+    if constexpr (M::friction) {
+        const Vec3<T> ut = u - un * n;
+        const T ut_abs = std::sqrt(dot(ut, ut));
+        if (ut_abs > T(0)) {
+            const T ft = std::min(p.mu * fn, p.gamma_t * mstar * ut_abs);
+            f_t = (-ft) * (ut / ut_abs);
+        }
+    }
+    f_i = (-fn) * n + f_t;
+}
+
+} // namespace detail
+
+// Particle–particle contact, i < j by id. Returns false (and writes nothing) when h <= 0.
+template <class M, class T>
+inline bool particle_contact(const Vec3<T>& xi, const Vec3<T>& xj, const Vec3<T>& vi, const Vec3<T>& vj,
+                             const Vec3<T>& wi, const Vec3<T>& wj, T ri, T rj, T mi, T mj,
+                             const ContactParams<T>& p, ContactForce<T>& out)
+{
+    const Vec3<T> dx = xj - xi;
+    const T d = std::sqrt(dot(dx, dx));
+    const T h = ri + rj - d;
+    if (!(h > T(0))) return false;
+    const Vec3<T> n = dx / d;
+    const T rstar = ri * rj / (ri + rj);
+    const T mstar = mi * mj / (mi + mj);
+    const Vec3<T> di = (ri - h * T(0.5)) * n;
+    const Vec3<T> dj = -((rj - h * T(0.5)) * n);
+    Vec3<T> u = vi - vj;
+    if constexpr (M::rotation) u = u + cross(wi, di) - cross(wj, dj);
+    Vec3<T> ft;
+    detail::contact_force<M>(n, h, u, rstar, mstar, p.hertz_pp, p, out.f_i, ft);
+    if constexpr (M::rotation) {
+        out.t_i = cross(di, ft);
+        out.t_j = cross(dj, -ft);
+    }
+    out.overlap = h;
+    return true;
+}
+
+// Particle–wall contact: the wall is a plane through `point` with unit normal `normal` pointing into
+// the domain, moving with velocity `vw`; R* = R_i, m* = m_i, E* from the particle and wall materials.
+template <class M, class T>
+inline bool wall_contact(const Vec3<T>& xi, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T mi,
+                         const Vec3<T>& point, const Vec3<T>& normal, const Vec3<T>& vw,
+                         const ContactParams<T>& p, ContactForce<T>& out)
+{
+    const T s = dot(xi - point, normal);
+    const T h = ri - s;
+    if (!(h > T(0))) return false;
+    const Vec3<T> n = -normal;
+    const Vec3<T> di = (ri - h * T(0.5)) * n;
+    Vec3<T> u = vi - vw;
+    if constexpr (M::rotation) u = u + cross(wi, di);
+    Vec3<T> ft;
+    detail::contact_force<M>(n, h, u, ri, mi, p.hertz_pw, p, out.f_i, ft);
+    if constexpr (M::rotation) out.t_i = cross(di, ft);
+    out.overlap = h;
+    return true;
+}
+
+// Newton's second law with gravity (physics.md §4 step 7): a = F/m + g, α = T/I.
+template <class T>
+inline T acceleration(T force, T mass, T gravity) { return force / mass + gravity; }
+
+} // namespace demmat

@@ -1,0 +1,46 @@
+#pragma once
+// The driver owns the clock: it calls a variant's phases in the paper's order and times each one.
+// Health checks (NaN, runaway speed, excessive overlap, a particle through a wall) run between steps,
+// outside the timed phases.
+#include <chrono>
+#include <cstdint>
+
+#include "demmat/variant.hpp"
+
+namespace demmat {
+
+struct PhaseTimes {  // seconds, summed over the steps taken
+    double predict = 0.0, search = 0.0, forces = 0.0, correct = 0.0;
+    double total() const { return predict + search + forces + correct; }
+};
+
+class Driver {
+public:
+    // Initialises the variant from the setup (not timed).
+    Driver(Variant& variant, const Setup& setup);
+
+    void step();                     // one timed step
+    void run(std::int64_t steps);    // `steps` timed steps, with health checks at the scene's interval
+    void check_health();             // throws InstabilityError naming the step and particle
+
+    std::int64_t current_step() const { return step_; }
+    double time() const { return double(step_) * setup_.gear.dt; }
+    const PhaseTimes& times() const { return times_; }
+    std::int64_t steps_taken() const { return steps_taken_; }
+    Variant& variant() { return variant_; }
+    const Setup& setup() const { return setup_; }
+
+private:
+    Variant& variant_;
+    const Setup& setup_;
+    std::int64_t step_;
+    std::int64_t steps_taken_ = 0;
+    PhaseTimes times_;
+    Snapshot scratch_;
+    double speed_bound_;
+};
+
+// Kinetic energy (translational + rotational) of a snapshot, summed in id order.
+double kinetic_energy(const Snapshot& s, const Setup& setup);
+
+} // namespace demmat

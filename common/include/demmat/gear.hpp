@@ -1,0 +1,62 @@
+#pragma once
+// The 5th-order Gear predictor–corrector of physics.md §3 (six values per degree of freedom), written
+// once. The kernels are templates on the value type V: a variant calls them on one double (a plain
+// loop), on one float, or on a whole Eigen array (an element-wise expression evaluates exactly the same
+// operations in the same order for every element).
+
+namespace demmat {
+
+// Per-run constants, computed once in double from Δt and rounded to T. Every variant and every port
+// uses these very values, so no variant can fold the constants differently.
+template <class T>
+struct GearCoefficients {
+    T dt{};            // Δt
+    T half_dt2{};      // Δt²/2
+    T two_over_dt2{};  // 2/Δt²
+    T cx{};            // c0·Δt²/2, c0 = 3/16
+    T cv{};            // c1·Δt/2,  c1 = 251/360
+    T c3{};            // c3·Δt²/2, c3 = 11/18
+    T c4{};            // c4·Δt²/2, c4 = 1/6
+    T c5{};            // c5·Δt²/2, c5 = 1/60   (c2 = 1: a = a_p + Δa)
+
+    static GearCoefficients make(double dt)
+    {
+        const double h2 = dt * dt / 2.0;
+        GearCoefficients k;
+        k.dt = T(dt);
+        k.half_dt2 = T(h2);
+        k.two_over_dt2 = T(2.0 / (dt * dt));
+        k.cx = T(3.0 / 16.0 * h2);
+        k.cv = T(251.0 / 360.0 * (dt / 2.0));
+        k.c3 = T(11.0 / 18.0 * h2);
+        k.c4 = T(1.0 / 6.0 * h2);
+        k.c5 = T(1.0 / 60.0 * h2);
+        return k;
+    }
+};
+
+// Predictor: Taylor expansion of the six values (Pascal's triangle on the scaled derivatives).
+// Updated in place in this order so that each line reads only values not yet predicted.
+template <class V, class T>
+inline void gear_predict(V& x, V& v, V& a, V& b3, V& b4, const V& b5, const GearCoefficients<T>& k)
+{
+    x = x + k.dt * v + k.half_dt2 * a + b3 + b4 + b5;
+    v = v + k.dt * a + (T(3) * b3 + T(4) * b4 + T(5) * b5) / k.dt;
+    a = a + k.two_over_dt2 * (T(3) * b3 + T(6) * b4 + T(10) * b5);
+    b3 = b3 + T(4) * b4 + T(10) * b5;
+    b4 = b4 + T(5) * b5;
+}
+
+// Corrector, with da = a_corrected − a_predicted already evaluated (a value, not a lazy expression).
+template <class V, class D, class T>
+inline void gear_correct(V& x, V& v, V& a, V& b3, V& b4, V& b5, const D& da, const GearCoefficients<T>& k)
+{
+    x = x + k.cx * da;
+    v = v + k.cv * da;
+    a = a + da;
+    b3 = b3 + k.c3 * da;
+    b4 = b4 + k.c4 * da;
+    b5 = b5 + k.c5 * da;
+}
+
+} // namespace demmat

@@ -1,0 +1,48 @@
+#pragma once
+// The full dynamic state of a run, in particle-id order: every Gear value for translation and
+// rotation, the walls and the step count. A run saved and continued from this state is bit-identical
+// to a run that never stopped.
+#include <cstdint>
+#include <filesystem>
+#include <string>
+#include <vector>
+
+#include "demmat/scene.hpp"
+#include "demmat/vec3.hpp"
+
+namespace demmat {
+
+struct GearState {  // six values per degree of freedom, for all particles
+    std::vector<Vec3d> x, v, a, b3, b4, b5;
+    void resize(std::size_t n) { x.resize(n); v.resize(n); a.resize(n); b3.resize(n); b4.resize(n); b5.resize(n); }
+};
+
+struct State {
+    std::int64_t step = 0;          // steps taken since the scene's t = 0; time = step·Δt
+    double dt = 0.0;
+    std::uint64_t fingerprint = 0;  // Scene::fingerprint of the scene that wrote it
+    std::vector<double> radius;
+    GearState trans;                // position, velocity, acceleration, b3, b4, b5
+    GearState rot;                  // orientation, angular velocity, angular acceleration, b3, b4, b5
+    std::vector<Wall> walls;
+
+    std::size_t size() const { return radius.size(); }
+    void resize(std::size_t n) { radius.resize(n); trans.resize(n); rot.resize(n); }
+};
+
+// Binary state file (format in docs/state-format.md); written to a temporary file and renamed.
+void save_state(const State& state, const std::filesystem::path& file);
+State load_state(const std::filesystem::path& file);
+
+// The initial state of a scene: its particles (generated, listed or loaded), its walls, and at t = 0
+// the accelerations a = F/m + g, α = T/I from the initial positions and velocities (b3 = b4 = b5 = 0).
+// Validates the particles (radii, overlaps, walls) and throws Error with one line on bad input.
+State initial_state(const Scene& scene);
+
+} // namespace demmat
+
+namespace demmat {
+// Refuses a time step above the Rayleigh time of the smallest particle (a scene that cannot be stable)
+// and returns a warning (empty if none) when Δt exceeds 0.2 of it, the usual rule of thumb.
+std::string check_time_step(const Scene& scene, const State& state);
+} // namespace demmat

@@ -1,0 +1,61 @@
+#pragma once
+// The one interface every variant implements. A variant owns its data layout and its contact store;
+// it knows nothing of clocks, files or statistics: the driver calls the four phases and times them.
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "demmat/contact_law.hpp"
+#include "demmat/gear.hpp"
+#include "demmat/scene.hpp"
+#include "demmat/state.hpp"
+
+namespace demmat {
+
+// What a variant receives at start: the scene, the full initial state, and the derived constants that
+// every variant must use as they are (so none derives them differently).
+struct Setup {
+    const Scene* scene = nullptr;
+    const State* state = nullptr;
+    ContactParams<double> contact;
+    GearCoefficients<double> gear;
+    std::vector<double> mass;     // per particle, id order (sphere_mass)
+    std::vector<double> inertia;  // per particle, id order (sphere_inertia)
+    double radius_max = 0.0;
+    double cell_size = 0.0;       // m; 0 when the search is all pairs
+
+    static Setup make(const Scene& scene, const State& state);
+};
+
+// Observable state after a step, in particle-id order; what the checker compares bit for bit.
+struct Snapshot {
+    std::int64_t step = 0;
+    std::vector<Vec3d> position, velocity, angular_velocity, force, torque;
+    void resize(std::size_t n) { position.resize(n); velocity.resize(n); angular_velocity.resize(n); force.resize(n); torque.resize(n); }
+};
+
+struct ContactCounts {
+    std::int64_t particle_particle = 0;  // contacts with h > 0 found by the last forces phase
+    std::int64_t particle_wall = 0;
+    std::int64_t candidates = 0;         // pairs the last search kept for the forces phase
+};
+
+class Variant {
+public:
+    virtual ~Variant() = default;
+
+    virtual void init(const Setup& setup) = 0;
+    // Phases of one step (physics.md §4). `step` is the number of the step being taken: the predictor
+    // puts moving walls at their position for this step.
+    virtual void predict(std::int64_t step) = 0;
+    virtual void search() = 0;
+    virtual void forces() = 0;   // contact forces, canonical summation, a = F/m + g, α = T/I
+    virtual void correct() = 0;
+
+    virtual void snapshot(Snapshot& out) const = 0;
+    virtual void save(State& out) const = 0;      // the full state, for save-and-continue
+    virtual ContactCounts counts() const = 0;
+    virtual std::size_t memory_bytes() const = 0;  // bytes held for particles and contacts
+};
+
+} // namespace demmat

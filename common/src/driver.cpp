@@ -1,0 +1,148 @@
+#include "demmat/driver.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "demmat/error.hpp"
+#include "demmat/reference.hpp"
+#include "demmat/registry.hpp"
+
+namespace demmat {
+
+Setup Setup::make(const Scene& scene, const State& state)
+{
+    Setup s;
+    s.scene = &scene;
+    s.state = &state;
+    s.contact = scene.contact_params();
+    s.gear = GearCoefficients<double>::make(scene.dt);
+    const std::size_t n = state.size();
+    s.mass.resize(n);
+    s.inertia.resize(n);
+    for (std::size_t i = 0; i < n; ++i) {
+        s.mass[i] = sphere_mass(state.radius[i], scene.material.density);
+        s.inertia[i] = sphere_inertia(state.radius[i], s.mass[i]);
+        s.radius_max = std::max(s.radius_max, state.radius[i]);
+    }
+    s.cell_size = scene.search.method == SearchMethod::cells ? scene.search.cell_size * s.radius_max : 0.0;
+    return s;
+}
+
+void Registry::add(VariantInfo info) { variants_.push_back(std::move(info)); }
+
+const VariantInfo& Registry::find(std::string_view name) const
+{
+    for (const auto& v : variants_)
+        if (v.name == name) return v;
+    throw Error(fmt::format("unknown variant '{}' (known: {})", name, fmt::join(names(), ", ")));
+}
+
+std::vector<std::string> Registry::names() const
+{
+    std::vector<std::string> out;
+    for (const auto& v : variants_) out.push_back(v.name);
+    return out;
+}
+
+double kinetic_energy(const Snapshot& s, const Setup& setup)
+{
+    double e = 0.0;
+    for (std::size_t i = 0; i < s.position.size(); ++i)
+        e += 0.5 * setup.mass[i] * dot(s.velocity[i], s.velocity[i]) +
+             0.5 * setup.inertia[i] * dot(s.angular_velocity[i], s.angular_velocity[i]);
+    return e;
+}
+
+Driver::Driver(Variant& variant, const Setup& setup) : variant_(variant), setup_(setup), step_(setup.state->step)
+{
+    variant_.init(setup_);
+    const Scene& scene = *setup.scene;
+    if (scene.checks.max_speed > 0.0) {
+        speed_bound_ = scene.checks.max_speed;
+    } else {
+        // Ten times the fastest speed the scene can explain: the fastest initial particle, a free fall
+        // across the domain, and the fastest wall.
+        double v0 = 0.0, vw = 0.0;
+        for (const Vec3d& v : setup.state->trans.v) v0 = std::max(v0, std::sqrt(dot(v, v)));
+        for (const Wall& w : setup.state->walls) vw = std::max(vw, std::sqrt(dot(w.velocity, w.velocity)));
+        const Vec3d ext = scene.domain.max - scene.domain.min;
+        const double fall = std::sqrt(2.0 * std::sqrt(dot(scene.gravity, scene.gravity)) * std::sqrt(dot(ext, ext)));
+        speed_bound_ = 10.0 * (v0 + fall + vw) + 1.0;
+    }
+}
+
+void Driver::step()
+{
+    using clock = std::chrono::steady_clock;
+    ++step_;
+    const auto t0 = clock::now();
+    variant_.predict(step_);
+    const auto t1 = clock::now();
+    variant_.search();
+    const auto t2 = clock::now();
+    variant_.forces();
+    const auto t3 = clock::now();
+    variant_.correct();
+    const auto t4 = clock::now();
+    times_.predict += std::chrono::duration<double>(t1 - t0).count();
+    times_.search += std::chrono::duration<double>(t2 - t1).count();
+    times_.forces += std::chrono::duration<double>(t3 - t2).count();
+    times_.correct += std::chrono::duration<double>(t4 - t3).count();
+    ++steps_taken_;
+}
+
+void Driver::run(std::int64_t steps)
+{
+    const int interval = setup_.scene->checks.interval;
+    for (std::int64_t k = 0; k < steps; ++k) {
+        step();
+        if (interval > 0 && (steps_taken_ % interval == 0 || k + 1 == steps)) check_health();
+    }
+}
+
+void Driver::check_health()
+{
+    variant_.snapshot(scratch_);
+    const Scene& scene = *setup_.scene;
+    const State& st = *setup_.state;
+    double rmin = st.radius.empty() ? 0.0 : *std::min_element(st.radius.begin(), st.radius.end());
+    const std::string hint = fmt::format("Δt = {:g} s; the Rayleigh time of the smallest particle is {:.3g} s, a step of at most "
+                                         "0.2 of it is usually stable", scene.dt, rayleigh_time(scene.material, rmin));
+    auto finite = [](const Vec3d& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
+    const std::size_t n = scratch_.position.size();
+    for (std::size_t i = 0; i < n; ++i) {
+        if (!finite(scratch_.position[i]) || !finite(scratch_.velocity[i]) || !finite(scratch_.angular_velocity[i]))
+            throw InstabilityError(fmt::format("step {}: particle {} has a non-finite position or velocity (NaN or Inf): "
+                                               "the run is unstable ({})", step_, i, hint), step_, std::int64_t(i));
+        const double speed = std::sqrt(dot(scratch_.velocity[i], scratch_.velocity[i]));
+        if (speed > speed_bound_)
+            throw InstabilityError(fmt::format("step {}: particle {} moves at {:.3g} m/s, above the bound {:.3g} m/s "
+                                               "(energy runaway; {})", step_, i, speed, speed_bound_, hint), step_, std::int64_t(i));
+    }
+    const double ratio = scene.checks.max_overlap_ratio;
+    for (const Wall& w : st.walls) {
+        const Vec3d p = w.point_at(step_, scene.dt);
+        for (std::size_t i = 0; i < n; ++i) {
+            const double s = dot(scratch_.position[i] - p, w.normal);
+            if (s < 0.0)
+                throw InstabilityError(fmt::format("step {}: particle {} passed through wall '{}' ({})", step_, i, w.name, hint),
+                                       step_, std::int64_t(i));
+            if ((st.radius[i] - s) > ratio * st.radius[i])
+                throw InstabilityError(fmt::format("step {}: particle {} overlaps wall '{}' by {:.3g} of its radius, above "
+                                                   "the bound {} ({})", step_, i, w.name, (st.radius[i] - s) / st.radius[i], ratio, hint),
+                                       step_, std::int64_t(i));
+        }
+    }
+    for (const auto& [i, j] : contact_pairs(scratch_.position, st.radius, false)) {
+        const Vec3d d = scratch_.position[j] - scratch_.position[i];
+        const double h = st.radius[i] + st.radius[j] - std::sqrt(dot(d, d));
+        const double r = std::min(st.radius[i], st.radius[j]);
+        if (h > ratio * r)
+            throw InstabilityError(fmt::format("step {}: particles {} and {} overlap by {:.3g} of the smaller radius, above "
+                                               "the bound {} ({})", step_, i, j, h / r, ratio, hint), step_, i);
+    }
+}
+
+} // namespace demmat

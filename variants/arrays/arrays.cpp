@@ -1,0 +1,379 @@
+// The plain-arrays processor, the paper's DEMMAT_F90 in C++: procedural free functions over flat
+// arrays of shape (N, 3) stored column by column (x(i, c) at x[c·N + i], as Fortran stores them),
+// capacities fixed up front and checked (the paper's "control of overestimation").
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "demmat/error.hpp"
+#include "demmat/registry.hpp"
+
+namespace demmat {
+namespace {
+
+using Index = std::int32_t;
+
+// ---- predictor and corrector: one loop over all 3N components --------------------------------------
+
+template <class T>
+void gear_predictor(std::size_t n3, T* x, T* v, T* a, T* b3, T* b4, const T* b5, const GearCoefficients<T>& k)
+{
+    for (std::size_t e = 0; e < n3; ++e) gear_predict(x[e], v[e], a[e], b3[e], b4[e], b5[e], k);
+}
+
+template <class T>
+void gear_corrector(std::size_t n3, T* x, T* v, T* a, T* b3, T* b4, T* b5, const T* a_new, const GearCoefficients<T>& k)
+{
+    for (std::size_t e = 0; e < n3; ++e) {
+        const T da = a_new[e] - a[e];
+        gear_correct(x[e], v[e], a[e], b3[e], b4[e], b5[e], da, k);
+    }
+}
+
+template <class T>
+Vec3<T> get(const T* a, std::size_t n, std::size_t i) { return {a[i], a[n + i], a[2 * n + i]}; }
+template <class T>
+void add(T* a, std::size_t n, std::size_t i, const Vec3<T>& v)
+{
+    a[i] += v.x;
+    a[n + i] += v.y;
+    a[2 * n + i] += v.z;
+}
+
+// ---- contact search --------------------------------------------------------------------------------
+
+// Neighbour list: for particle i, its candidate partners j > i in ascending order, at most `cap`.
+struct NeighbourList {
+    Index cap = 0;
+    std::vector<Index> count;    // (N)
+    std::vector<Index> partner;  // (N, cap), row i at [i·cap]
+};
+
+// Boundary list: for particle i, the walls it may touch, in wall order.
+struct BoundaryList {
+    Index cap = 0;
+    std::vector<Index> count;  // (N)
+    std::vector<Index> wall;   // (N, cap)
+};
+
+[[noreturn]] void neighbour_overflow(Index i, Index cap, Index needed)
+{
+    throw CapacityError(fmt::format("capacity.contacts_per_particle = {} exceeded: particle {} has at least {} candidate "
+                                    "partners; set it to at least {} in the scene", cap, i, needed, needed + 8));
+}
+
+template <class T>
+void insert_sorted(Index* row, Index count, Index j)
+{
+    Index k = count;
+    while (k > 0 && row[k - 1] > j) {
+        row[k] = row[k - 1];
+        --k;
+    }
+    row[k] = j;
+}
+
+// Every pair (the paper's "no cells"), O(N²).
+template <class T>
+void search_all_pairs(std::size_t n, const T* x, const T* r, NeighbourList& nl)
+{
+    for (std::size_t i = 0; i < n; ++i) {
+        Index c = 0;
+        Index* row = &nl.partner[i * std::size_t(nl.cap)];
+        const Vec3<T> xi = get(x, n, i);
+        for (std::size_t j = i + 1; j < n; ++j) {
+            if (!may_touch(xi, get(x, n, j), r[i], r[j])) continue;
+            if (c == nl.cap) neighbour_overflow(Index(i), nl.cap, c + 1);
+            row[c++] = Index(j);
+        }
+        nl.count[i] = c;
+    }
+}
+
+// Linked cells: cubic cells of edge s over the particles' bounding box, each cell a linked list
+// (head, next) as in the Fortran original. The table of list heads has a fixed size (a power of two
+// ≥ 2N): when the box has no more cells than that, a cell's index is its slot; otherwise cells are
+// hashed into it, and a particle is taken from a slot only if its own cell is the one visited. Memory
+// is thus O(N) whatever the extent of the domain (the paper's 2 m box would need 200³ cells).
+struct CellGrid {
+    std::vector<Index> head;              // (table)
+    std::vector<Index> next;              // (N)
+    std::vector<std::int64_t> cx, cy, cz; // (N) integer cell coordinates
+    std::int64_t dims[3] = {0, 0, 0};
+    std::uint64_t mask = 0;
+    bool direct = true;
+
+    std::uint64_t slot(std::int64_t ix, std::int64_t iy, std::int64_t iz) const
+    {
+        if (direct) return std::uint64_t(ix + dims[0] * (iy + dims[1] * iz));
+        const std::uint64_t h = std::uint64_t(ix) * 73856093ull ^ std::uint64_t(iy) * 19349663ull ^ std::uint64_t(iz) * 83492791ull;
+        return (h * 0x9e3779b97f4a7c15ull >> 20) & mask;
+    }
+};
+
+template <class T>
+void search_cells(std::size_t n, const T* x, const T* r, T edge, CellGrid& g, NeighbourList& nl)
+{
+    T lo[3];
+    for (int c = 0; c < 3; ++c) lo[c] = *std::min_element(x + c * n, x + (c + 1) * n);
+    std::int64_t* cc[3] = {g.cx.data(), g.cy.data(), g.cz.data()};
+    for (int c = 0; c < 3; ++c) {
+        std::int64_t hi = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            cc[c][i] = std::int64_t(std::floor((x[c * n + i] - lo[c]) / edge));
+            hi = std::max(hi, cc[c][i]);
+        }
+        g.dims[c] = hi + 1;
+    }
+    const auto table = std::uint64_t(g.head.size());
+    g.direct = double(g.dims[0]) * double(g.dims[1]) * double(g.dims[2]) <= double(table);
+    g.mask = table - 1;
+    std::fill(g.head.begin(), g.head.end(), Index(-1));
+    for (std::size_t i = n; i-- > 0;) {  // pushed in descending order: each cell's list ascends
+        const std::uint64_t s = g.slot(g.cx[i], g.cy[i], g.cz[i]);
+        g.next[i] = g.head[s];
+        g.head[s] = Index(i);
+    }
+    for (std::size_t i = 0; i < n; ++i) {
+        Index c = 0;
+        Index* row = &nl.partner[i * std::size_t(nl.cap)];
+        const Vec3<T> xi = get(x, n, i);
+        for (std::int64_t dz = -1; dz <= 1; ++dz) {
+            const std::int64_t qz = g.cz[i] + dz;
+            if (qz < 0 || qz >= g.dims[2]) continue;
+            for (std::int64_t dy = -1; dy <= 1; ++dy) {
+                const std::int64_t qy = g.cy[i] + dy;
+                if (qy < 0 || qy >= g.dims[1]) continue;
+                for (std::int64_t dx = -1; dx <= 1; ++dx) {
+                    const std::int64_t qx = g.cx[i] + dx;
+                    if (qx < 0 || qx >= g.dims[0]) continue;
+                    for (Index j = g.head[g.slot(qx, qy, qz)]; j >= 0; j = g.next[j]) {
+                        if (std::size_t(j) <= i) continue;
+                        if (!g.direct && (g.cx[j] != qx || g.cy[j] != qy || g.cz[j] != qz)) continue;
+                        if (!may_touch(xi, get(x, n, std::size_t(j)), r[i], r[j])) continue;
+                        if (c == nl.cap) neighbour_overflow(Index(i), nl.cap, c + 1);
+                        insert_sorted<T>(row, c++, j);  // the canonical order needs partners ascending
+                    }
+                }
+            }
+        }
+        nl.count[i] = c;
+    }
+}
+
+template <class T>
+void search_walls(std::size_t n, const T* x, const T* r, std::size_t nw, const T* wp, const T* wn, BoundaryList& bl)
+{
+    std::fill(bl.count.begin(), bl.count.end(), Index(0));
+    for (std::size_t w = 0; w < nw; ++w) {
+        const Vec3<T> p{wp[3 * w], wp[3 * w + 1], wp[3 * w + 2]}, nv{wn[3 * w], wn[3 * w + 1], wn[3 * w + 2]};
+        for (std::size_t i = 0; i < n; ++i) {
+            if (!may_touch_wall(get(x, n, i), r[i], p, nv)) continue;
+            Index& c = bl.count[i];
+            if (c == bl.cap)
+                throw CapacityError(fmt::format("capacity.wall_contacts_per_particle = {} exceeded: particle {} touches more "
+                                                "walls; set it to at least {}", bl.cap, i, c + 1));
+            bl.wall[i * std::size_t(bl.cap) + std::size_t(c++)] = Index(w);
+        }
+    }
+}
+
+// ---- the processor ---------------------------------------------------------------------------------
+
+template <class T, class M>
+class ArraysVariant final : public Variant {
+public:
+    void init(const Setup& setup) override
+    {
+        const State& s = *setup.state;
+        const Scene& scene = *setup.scene;
+        n_ = s.size();
+        step_ = s.step;
+        gear_ = GearCoefficients<T>::make(scene.dt);
+        params_ = setup.contact.template as<T>();
+        g_ = cast<T>(scene.gravity);
+        walls_ = s.walls;
+        dt_ = scene.dt;
+        cell_ = T(setup.cell_size);
+        for (auto* arr : {&x_, &v_, &a_, &b3_, &b4_, &b5_, &th_, &w_, &al_, &r3_, &r4_, &r5_, &f_, &t_, &acc_, &alc_})
+            arr->assign(3 * n_, T(0));
+        auto load = [this](std::vector<T>& dst, const std::vector<Vec3d>& src) {
+            for (std::size_t i = 0; i < n_; ++i)
+                for (int c = 0; c < 3; ++c) dst[c * n_ + i] = T(component(src[i], c));
+        };
+        load(x_, s.trans.x); load(v_, s.trans.v); load(a_, s.trans.a);
+        load(b3_, s.trans.b3); load(b4_, s.trans.b4); load(b5_, s.trans.b5);
+        load(th_, s.rot.x); load(w_, s.rot.v); load(al_, s.rot.a);
+        load(r3_, s.rot.b3); load(r4_, s.rot.b4); load(r5_, s.rot.b5);
+        r_.resize(n_); m_.resize(n_); I_.resize(n_);
+        for (std::size_t i = 0; i < n_; ++i) {
+            r_[i] = T(s.radius[i]);
+            m_[i] = T(setup.mass[i]);
+            I_[i] = T(setup.inertia[i]);
+        }
+        nw_ = walls_.size();
+        wp_.assign(3 * nw_, T(0)); wn_.assign(3 * nw_, T(0)); wv_.assign(3 * nw_, T(0));
+        for (std::size_t w = 0; w < nw_; ++w)
+            for (int c = 0; c < 3; ++c) {
+                wn_[3 * w + c] = T(component(walls_[w].normal, c));
+                wv_[3 * w + c] = T(component(walls_[w].velocity, c));
+            }
+        place_walls(step_);
+        nl_.cap = Index(scene.capacity.contacts_per_particle);
+        nl_.count.assign(n_, 0);
+        nl_.partner.assign(n_ * std::size_t(nl_.cap), 0);
+        bl_.cap = Index(scene.capacity.wall_contacts_per_particle);
+        bl_.count.assign(n_, 0);
+        bl_.wall.assign(n_ * std::size_t(bl_.cap), 0);
+        std::size_t table = 1;
+        while (table < 2 * n_) table *= 2;
+        grid_.head.assign(table, -1);
+        grid_.next.assign(n_, -1);
+        grid_.cx.assign(n_, 0); grid_.cy.assign(n_, 0); grid_.cz.assign(n_, 0);
+    }
+
+    void predict(std::int64_t step) override
+    {
+        step_ = step;
+        gear_predictor(3 * n_, x_.data(), v_.data(), a_.data(), b3_.data(), b4_.data(), b5_.data(), gear_);
+        if constexpr (M::rotation)
+            gear_predictor(3 * n_, th_.data(), w_.data(), al_.data(), r3_.data(), r4_.data(), r5_.data(), gear_);
+        place_walls(step);
+    }
+
+    void search() override
+    {
+        if (cell_ > T(0)) search_cells(n_, x_.data(), r_.data(), cell_, grid_, nl_);
+        else search_all_pairs(n_, x_.data(), r_.data(), nl_);
+        search_walls(n_, x_.data(), r_.data(), nw_, wp_.data(), wn_.data(), bl_);
+    }
+
+    void forces() override
+    {
+        std::fill(f_.begin(), f_.end(), T(0));
+        std::fill(t_.begin(), t_.end(), T(0));
+        pp_ = 0;
+        pw_ = 0;
+        candidates_ = 0;
+        const std::size_t n = n_;
+        for (std::size_t i = 0; i < n; ++i) {
+            const Index* row = &nl_.partner[i * std::size_t(nl_.cap)];
+            candidates_ += nl_.count[i];
+            for (Index k = 0; k < nl_.count[i]; ++k) {
+                const auto j = std::size_t(row[k]);
+                ContactForce<T> c;
+                if (!particle_contact<M>(get(x_.data(), n, i), get(x_.data(), n, j), get(v_.data(), n, i), get(v_.data(), n, j),
+                                         get(w_.data(), n, i), get(w_.data(), n, j), r_[i], r_[j], m_[i], m_[j], params_, c))
+                    continue;
+                ++pp_;
+                add(f_.data(), n, i, c.f_i);
+                add(f_.data(), n, j, -c.f_i);
+                if constexpr (M::rotation) {
+                    add(t_.data(), n, i, c.t_i);
+                    add(t_.data(), n, j, c.t_j);
+                }
+            }
+        }
+        for (std::size_t i = 0; i < n; ++i) {
+            const Index* row = &bl_.wall[i * std::size_t(bl_.cap)];
+            for (Index k = 0; k < bl_.count[i]; ++k) {
+                const auto w = std::size_t(row[k]);
+                ContactForce<T> c;
+                if (!wall_contact<M>(get(x_.data(), n, i), get(v_.data(), n, i), get(w_.data(), n, i), r_[i], m_[i],
+                                     Vec3<T>{wp_[3 * w], wp_[3 * w + 1], wp_[3 * w + 2]},
+                                     Vec3<T>{wn_[3 * w], wn_[3 * w + 1], wn_[3 * w + 2]},
+                                     Vec3<T>{wv_[3 * w], wv_[3 * w + 1], wv_[3 * w + 2]}, params_, c))
+                    continue;
+                ++pw_;
+                add(f_.data(), n, i, c.f_i);
+                if constexpr (M::rotation) add(t_.data(), n, i, c.t_i);
+            }
+        }
+        const T g[3] = {g_.x, g_.y, g_.z};
+        for (int c = 0; c < 3; ++c)
+            for (std::size_t i = 0; i < n; ++i) {
+                acc_[c * n + i] = acceleration(f_[c * n + i], m_[i], g[c]);
+                if constexpr (M::rotation) alc_[c * n + i] = t_[c * n + i] / I_[i];
+            }
+    }
+
+    void correct() override
+    {
+        gear_corrector(3 * n_, x_.data(), v_.data(), a_.data(), b3_.data(), b4_.data(), b5_.data(), acc_.data(), gear_);
+        if constexpr (M::rotation)
+            gear_corrector(3 * n_, th_.data(), w_.data(), al_.data(), r3_.data(), r4_.data(), r5_.data(), alc_.data(), gear_);
+    }
+
+    void snapshot(Snapshot& out) const override
+    {
+        out.resize(n_);
+        out.step = step_;
+        for (std::size_t i = 0; i < n_; ++i) {
+            out.position[i] = cast<double>(get(x_.data(), n_, i));
+            out.velocity[i] = cast<double>(get(v_.data(), n_, i));
+            out.angular_velocity[i] = cast<double>(get(w_.data(), n_, i));
+            out.force[i] = cast<double>(get(f_.data(), n_, i));
+            out.torque[i] = cast<double>(get(t_.data(), n_, i));
+        }
+    }
+
+    void save(State& out) const override
+    {
+        out.resize(n_);
+        out.step = step_;
+        out.walls = walls_;
+        const std::vector<T>* src[12] = {&x_, &v_, &a_, &b3_, &b4_, &b5_, &th_, &w_, &al_, &r3_, &r4_, &r5_};
+        std::vector<Vec3d>* dst[12] = {&out.trans.x, &out.trans.v, &out.trans.a, &out.trans.b3, &out.trans.b4, &out.trans.b5,
+                                       &out.rot.x,   &out.rot.v,   &out.rot.a,   &out.rot.b3,   &out.rot.b4,   &out.rot.b5};
+        for (int k = 0; k < 12; ++k)
+            for (std::size_t i = 0; i < n_; ++i) (*dst[k])[i] = cast<double>(get(src[k]->data(), n_, i));
+        for (std::size_t i = 0; i < n_; ++i) out.radius[i] = double(r_[i]);
+    }
+
+    ContactCounts counts() const override { return {pp_, pw_, candidates_}; }
+
+    std::size_t memory_bytes() const override
+    {
+        return 19 * 3 * n_ * sizeof(T) + (nl_.partner.size() + nl_.count.size() + bl_.wall.size() + bl_.count.size()) * sizeof(Index) +
+               grid_.head.size() * sizeof(Index) + grid_.next.size() * sizeof(Index) + 3 * n_ * sizeof(std::int64_t);
+    }
+
+private:
+    void place_walls(std::int64_t step)
+    {
+        for (std::size_t w = 0; w < nw_; ++w) {
+            const Vec3d p = walls_[w].point_at(step, dt_);
+            for (int c = 0; c < 3; ++c) wp_[3 * w + c] = T(component(p, c));
+        }
+    }
+
+    std::size_t n_ = 0, nw_ = 0;
+    std::int64_t step_ = 0;
+    double dt_ = 0.0;
+    T cell_ = T(0);
+    GearCoefficients<T> gear_;
+    ContactParams<T> params_;
+    Vec3<T> g_;
+    std::vector<Wall> walls_;
+    std::vector<T> x_, v_, a_, b3_, b4_, b5_, th_, w_, al_, r3_, r4_, r5_;  // (N, 3) each
+    std::vector<T> f_, t_, acc_, alc_;                                      // (N, 3) each
+    std::vector<T> r_, m_, I_;                                              // (N)
+    std::vector<T> wp_, wn_, wv_;                                           // (3, walls)
+    NeighbourList nl_;
+    BoundaryList bl_;
+    CellGrid grid_;
+    std::int64_t pp_ = 0, pw_ = 0, candidates_ = 0;
+};
+
+} // namespace
+
+void register_variant_arrays(Registry& r)
+{
+    r.add({"arrays", "plain arrays, procedural, Fortran-90 style (the paper's DEMMAT_F90)",
+           [] { return std::make_unique<ArraysVariant<double, FullModel>>(); }});
+}
+
+} // namespace demmat
