@@ -27,7 +27,8 @@ struct Setup {
     static Setup make(const Scene& scene, const State& state);
 };
 
-// Observable state after a step, in particle-id order; what the checker compares bit for bit.
+// Observable state after a step, in particle-id order; what the checker compares bit for bit. Before
+// the first step (right after init) force and torque are zero in every variant.
 struct Snapshot {
     std::int64_t step = 0;
     std::vector<Vec3d> position, velocity, angular_velocity, force, torque;
