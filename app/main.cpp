@@ -357,7 +357,7 @@ int main(int argc, char** argv)
     run->add_option("--vtk", ra.vtk_dir, "Write VTK snapshots and a .pvd series (ParaView) into this folder");
     run->add_option("--vtk-every", ra.vtk_every, "Steps between VTK snapshots (0: first and last only)");
     run->add_flag("--quiet,-q", ra.quiet, "No progress on stderr");
-    run->add_flag("--allow-unstable", ra.allow_unstable, "Silence the time-step warning");
+    run->add_flag("--allow-unstable", ra.allow_unstable, "Run even with a time step above the Rayleigh time, without warning");
 
     std::string cmp_scene, cmp_variants = "all";
     std::int64_t cmp_steps = 100;
@@ -368,7 +368,7 @@ int main(int argc, char** argv)
     compare->add_option("--variants", cmp_variants, "Comma-separated variant names, or all");
     auto* cmp_steps_opt = compare->add_option("--steps,-n", cmp_steps, "Number of steps");
     compare->add_option("--time,-t", cmp_time, "Simulated time (s), instead of --steps")->excludes(cmp_steps_opt);
-    compare->add_flag("--allow-unstable", cmp_allow, "Silence the time-step warning");
+    compare->add_flag("--allow-unstable", cmp_allow, "Run even with a time step above the Rayleigh time, without warning");
 
     BenchArgs ba;
     auto* bench = app.add_subcommand("bench", "Time variants per phase: interleaved repetitions, medians and spread");
@@ -378,7 +378,7 @@ int main(int argc, char** argv)
     bench->add_option("--repetitions,-r", ba.repetitions, "Repetitions")->check(CLI::PositiveNumber);
     bench->add_option("--warmup", ba.warmup, "Untimed steps before each repetition")->check(CLI::NonNegativeNumber);
     bench->add_option("--json", ba.json_file, "Write the samples and medians as JSON with provenance");
-    bench->add_flag("--allow-unstable", ba.allow_unstable, "Silence the time-step warning");
+    bench->add_flag("--allow-unstable", ba.allow_unstable, "Run even with a time step above the Rayleigh time, without warning");
 
     try {
         app.parse(argc, argv);

@@ -161,10 +161,12 @@ void validate_new_particles(const Scene& scene, const State& s)
     }
 }
 
+} // namespace
+
 // Walls of a run that starts from a saved state: a wall the state knows keeps its position; if the
 // scene gives it another velocity, its motion is re-anchored at the state's step (a new stage, e.g.
 // compression after settling). A wall the state does not know starts where the scene puts it.
-std::vector<Wall> merge_walls(const Scene& scene, const State& saved)
+std::vector<Wall> continue_walls(const Scene& scene, const State& saved)
 {
     std::vector<Wall> out;
     for (const Wall& w : scene.walls) {
@@ -183,8 +185,6 @@ std::vector<Wall> merge_walls(const Scene& scene, const State& saved)
     }
     return out;
 }
-
-} // namespace
 
 void save_state(const State& s, const std::filesystem::path& file)
 {
@@ -267,7 +267,7 @@ State initial_state(const Scene& scene)
             throw Error(fmt::format("{}: state file {} was written for another scene (materials, time step, gravity or "
                                     "particle count differ)", scene.name, scene.state_file.string()));
         s = saved;
-        s.walls = merge_walls(scene, saved);
+        s.walls = continue_walls(scene, saved);
         return s;
     }
     s.walls = scene.walls;

@@ -34,6 +34,11 @@ struct State {
 void save_state(const State& state, const std::filesystem::path& file);
 State load_state(const std::filesystem::path& file);
 
+// Walls of a run that starts from a saved state: a wall the state knows keeps its position; if the
+// scene gives it another velocity, its motion is re-anchored at the state's step (a new stage, such as
+// compression after settling). A wall the state does not know starts where the scene puts it.
+std::vector<Wall> continue_walls(const Scene& scene, const State& saved);
+
 // The initial state of a scene: its particles (generated, listed or loaded), its walls, and at t = 0
 // the accelerations a = F/m + g, α = T/I from the initial positions and velocities (b3 = b4 = b5 = 0).
 // Validates the particles (radii, overlaps, walls) and throws Error with one line on bad input.

@@ -1,0 +1,117 @@
+// Scenes: the generator is deterministic, scene files round-trip, and bad scenes are refused with a
+// one-line message naming the problem.
+#include <gtest/gtest.h>
+
+#include "demmat/error.hpp"
+#include "support.hpp"
+
+using namespace demmat;
+using namespace demmat::test;
+
+TEST(Generator, SameSeedSameStateOtherSeedOtherState)
+{
+    const State a = initial_state(dense_bed_scene(500, 5));
+    const State b = initial_state(dense_bed_scene(500, 5));
+    const State c = initial_state(dense_bed_scene(500, 6));
+    EXPECT_EQ(a.radius, b.radius);
+    EXPECT_TRUE(a.trans.v[123] == b.trans.v[123]);
+    EXPECT_NE(a.radius, c.radius);
+    for (double r : a.radius) {
+        EXPECT_GE(r, 0.003);
+        EXPECT_LE(r, 0.005);
+    }
+    for (const Vec3d& v : a.trans.v) EXPECT_LE(std::sqrt(dot(v, v)), 1.0 + 1e-15);
+}
+
+TEST(Generator, InitialAccelerationIsGravityWhenNothingTouches)
+{
+    const State s = initial_state(paper_scene());
+    EXPECT_EQ(s.size(), 1000u);
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        EXPECT_EQ(s.trans.a[i].z, -10.0);
+        EXPECT_EQ(s.trans.b3[i].z, 0.0);
+    }
+}
+
+TEST(SceneFile, RoundTripsThroughToml)
+{
+    for (const Scene& s : {paper_scene(), dense_bed_scene(1234, 9), head_on_scene(2.0), drop_scene(0.002)}) {
+        const Scene r = parse_scene(scene_to_toml(s), "roundtrip");
+        EXPECT_EQ(r.name, s.name);
+        EXPECT_EQ(r.dt, s.dt);
+        EXPECT_EQ(r.walls.size(), s.walls.size());
+        EXPECT_EQ(r.fingerprint(10), s.fingerprint(10));
+        const State a = initial_state(s), b = initial_state(r);
+        EXPECT_EQ(a.radius, b.radius);
+        EXPECT_EQ(a.trans.x.size(), b.trans.x.size());
+        for (std::size_t i = 0; i < a.size(); ++i) EXPECT_TRUE(a.trans.x[i] == b.trans.x[i]);
+    }
+}
+
+namespace {
+std::string error_of(const std::string& toml)
+{
+    try {
+        const Scene s = parse_scene(toml, "bad.toml");
+        initial_state(s);
+    } catch (const Error& e) {
+        return e.what();
+    }
+    return "";
+}
+const char* kGood = R"(
+[time]
+dt = 1e-5
+[domain]
+min = [0, 0, 0]
+max = [0.1, 0.1, 0.1]
+[[wall]]
+face = "z_min"
+[particles]
+source = "list"
+[[particles.particle]]
+radius = 0.004
+position = [0.05, 0.05, 0.05]
+)";
+} // namespace
+
+TEST(SceneFile, BadScenesGiveOneLineErrors)
+{
+    EXPECT_EQ(error_of(kGood), "");
+    auto with = [](const std::string& from, const std::string& to) {
+        std::string s = kGood;
+        s.replace(s.find(from), from.size(), to);
+        return s;
+    };
+    const std::pair<std::string, std::string> cases[] = {
+        {with("radius = 0.004", "radius = -0.004"), "must be > 0"},
+        {with("dt = 1e-5", "dt = 0"), "'time.dt' must be > 0"},
+        {with("dt = 1e-5", "dtt = 1e-5"), "missing key 'dt'"},
+        {with("[time]", "[time]\nextra = 1"), "unknown key 'extra'"},
+        {with("source = \"list\"", "source = \"cloud\""), "must be grid, list or state"},
+        {with("position = [0.05, 0.05, 0.05]", "position = [0.05, 0.05, 0.002]"), "overlaps wall 'z_min'"},
+        {with("position = [0.05, 0.05, 0.05]", "position = [0.05, 0.05, 0.5]"), "outside the domain"},
+        {with("position = [0.05, 0.05, 0.05]", "position = [0.05, 0.05]"), "array of 3 numbers"},
+        {with("dt = 1e-5", "dt = \"fast\""), "must be a number"},
+        {with("dt = 1e-5", "dt = 1e-5\ngravity = [0, 0, nan]"), "must be finite"},
+        {with("max = [0.1, 0.1, 0.1]", "max = [0.1, 0.1"), "TOML syntax error"},
+        {with("face = \"z_min\"", "face = \"floor\""), "unknown box face"},
+        {std::string(kGood) + "[search]\nmethod = \"octree\"\n", "unknown search method 'octree'"},
+        {std::string(kGood) + "[[particles.particle]]\nradius = 0.004\nposition = [0.053, 0.05, 0.05]\n", "particles 0 and 1 overlap"},
+    };
+    for (const auto& [toml, expect] : cases) {
+        const std::string e = error_of(toml);
+        EXPECT_NE(e.find(expect), std::string::npos) << "expected '" << expect << "', got '" << e << "'";
+        EXPECT_EQ(e.find('\n'), std::string::npos) << "not one line: " << e;
+    }
+}
+
+TEST(SceneFile, TimeStepAboveTheRayleighTimeIsRefused)
+{
+    Scene s = drop_scene();
+    s.dt = 1e-3;  // the Rayleigh time of a 4 mm grain of the paper's material is 1.3e-3 s
+    const State st = initial_state(s);
+    EXPECT_FALSE(check_time_step(s, st).empty());  // warned: above 0.2 T_R
+    s.dt = 2e-3;
+    EXPECT_THROW(check_time_step(s, initial_state(s)), Error);
+}
