@@ -59,7 +59,10 @@ std::vector<std::string> variant_list(const std::string& spec)
     std::string cur;
     for (char c : spec + ",") {
         if (c == ',') {
-            if (!cur.empty()) out.push_back(registry().find(cur).name);
+            if (!cur.empty()) {
+                if (std::find(out.begin(), out.end(), cur) != out.end()) throw Error(fmt::format("variant '{}' is named twice", cur));
+                out.push_back(registry().find(cur).name);
+            }
             cur.clear();
         } else {
             cur += c;

@@ -1,0 +1,103 @@
+#!/usr/bin/python3
+"""Per-phase CPU time per variant from a `demmat bench` JSON file (the paper's Figure 7 layout).
+
+Writes a grouped bar chart (log scale, median with min–max whiskers over the interleaved repetitions)
+and a CSV table of seconds per step and of each variant's ratio to the arrays variant per phase.
+Reads structured fields only; nothing is parsed out of labels.
+
+Usage: /usr/bin/python3 analysis/plot_phases.py BENCH.json --figure OUT.png --table OUT.csv
+"""
+import argparse
+import json
+import os
+import sys
+import tempfile
+
+import matplotlib
+
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+import pandas as pd  # noqa: E402
+
+PHASES = ["predict", "search", "forces", "correct"]
+GROUPS = PHASES + ["search_plus_forces", "total"]
+
+
+def tidy_samples(bench):
+    """One row per (variant, repetition, phase) with seconds per step."""
+    df = pd.DataFrame(bench["samples"])
+    wide = df.pivot_table(index=["variant", "repetition"], columns="phase", values="seconds_per_step").reset_index()
+    wide["search_plus_forces"] = wide["search"] + wide["forces"]
+    wide["total"] = wide[PHASES].sum(axis=1)
+    return wide.melt(id_vars=["variant", "repetition"], value_vars=GROUPS, var_name="phase", value_name="seconds_per_step")
+
+
+def table(tidy, order):
+    stats = tidy.groupby(["variant", "phase"])["seconds_per_step"].agg(["median", "min", "max"]).reset_index()
+    ref = stats[stats.variant == "arrays"].set_index("phase")["median"] if "arrays" in order else None
+    if ref is not None:
+        stats["ratio_to_arrays"] = stats.apply(lambda r: r["median"] / ref[r["phase"]], axis=1)
+    stats["variant"] = pd.Categorical(stats["variant"], order)
+    stats["phase"] = pd.Categorical(stats["phase"], GROUPS)
+    return stats.sort_values(["variant", "phase"]).reset_index(drop=True)
+
+
+def atomic_write(path, write):
+    d = os.path.dirname(os.path.abspath(path))
+    os.makedirs(d, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(dir=d, suffix=os.path.splitext(path)[1])
+    os.close(fd)
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        os.unlink(tmp)
+        raise
+
+
+def caption(bench):
+    p, s = bench["provenance"], bench["scene"]
+    dirty = " (dirty)" if p["dirty"] else ""
+    return (f"{s['name']}: {s['particles']} particles, {s['search']} {s['cell_size_rmax']:g}·Rmax, "
+            f"{bench['repetitions']} interleaved repetitions × {bench['steps']} steps\n"
+            f"{p['cpu']} · {p['compiler']} {p['flags']} · commit {p['commit'][:10]}{dirty} · {p['date']}")
+
+
+def figure(stats, order, bench, path):
+    phases = ["predict", "search", "forces", "correct", "total"]
+    fig, ax = plt.subplots(figsize=(9, 4.8))
+    width = 0.8 / max(1, len(order))
+    for k, v in enumerate(order):
+        sub = stats[stats.variant == v].set_index("phase").loc[phases]
+        x = [i + (k - (len(order) - 1) / 2) * width for i in range(len(phases))]
+        err = [sub["median"] - sub["min"], sub["max"] - sub["median"]]
+        ax.bar(x, sub["median"], width, yerr=err, capsize=2, label=v)
+    ax.set_yscale("log")
+    ax.set_xticks(range(len(phases)))
+    ax.set_xticklabels(phases)
+    ax.set_ylabel("CPU time per step (s)")
+    ax.legend(ncol=min(4, len(order)), fontsize=8)
+    ax.grid(axis="y", which="both", alpha=0.3)
+    ax.set_title("Per-phase CPU time per variant (median, min–max whiskers)", fontsize=10)
+    fig.text(0.01, 0.01, caption(bench), fontsize=6.5, va="bottom")
+    fig.tight_layout(rect=(0, 0.07, 1, 1))
+    atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=150, format="png"))
+
+
+def main(argv):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("bench", help="JSON written by `demmat bench --json`")
+    ap.add_argument("--figure", required=True)
+    ap.add_argument("--table", required=True)
+    a = ap.parse_args(argv)
+    with open(a.bench) as f:
+        bench = json.load(f)
+    order = [s["variant"] for s in bench["summary"]]
+    stats = table(tidy_samples(bench), order)
+    atomic_write(a.table, lambda tmp: stats.to_csv(tmp, index=False, float_format="%.6g"))
+    figure(stats, order, bench, a.figure)
+    print(stats.to_string(index=False, float_format=lambda x: f"{x:.4g}"))
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])
