@@ -59,11 +59,20 @@ struct BoundaryList {
     std::vector<Index> wall;   // (N, cap)
 };
 
-[[noreturn]] void neighbour_overflow(Index i, Index cap, Index needed)
-{
-    throw CapacityError(fmt::format("capacity.contacts_per_particle = {} exceeded: particle {} has at least {} candidate "
-                                    "partners; set it to at least {} in the scene", cap, i, needed, needed + 8));
-}
+// On overflow the search goes on counting (without storing) so the message can give the value that fits.
+struct Overflow {
+    Index worst = 0, particle = -1;
+    void note(Index count, std::size_t i)
+    {
+        if (count > worst) { worst = count; particle = Index(i); }
+    }
+    void check(Index cap) const
+    {
+        if (worst > cap)
+            throw CapacityError(fmt::format("capacity.contacts_per_particle = {} exceeded: particle {} has {} candidate "
+                                            "partners; set it to at least {} in the scene", cap, particle, worst, worst));
+    }
+};
 
 template <class T>
 void insert_sorted(Index* row, Index count, Index j)
@@ -80,17 +89,20 @@ void insert_sorted(Index* row, Index count, Index j)
 template <class T>
 void search_all_pairs(std::size_t n, const T* x, const T* r, NeighbourList& nl)
 {
+    Overflow over;
     for (std::size_t i = 0; i < n; ++i) {
         Index c = 0;
         Index* row = &nl.partner[i * std::size_t(nl.cap)];
         const Vec3<T> xi = get(x, n, i);
         for (std::size_t j = i + 1; j < n; ++j) {
             if (!may_touch(xi, get(x, n, j), r[i], r[j])) continue;
-            if (c == nl.cap) neighbour_overflow(Index(i), nl.cap, c + 1);
-            row[c++] = Index(j);
+            if (c < nl.cap) row[c] = Index(j);
+            ++c;
         }
-        nl.count[i] = c;
+        over.note(c, i);
+        nl.count[i] = std::min(c, nl.cap);
     }
+    over.check(nl.cap);
 }
 
 // Linked cells: cubic cells of edge s over the particles' bounding box, each cell a linked list
@@ -137,6 +149,7 @@ void search_cells(std::size_t n, const T* x, const T* r, T edge, CellGrid& g, Ne
         g.next[i] = g.head[s];
         g.head[s] = Index(i);
     }
+    Overflow over;
     for (std::size_t i = 0; i < n; ++i) {
         Index c = 0;
         Index* row = &nl.partner[i * std::size_t(nl.cap)];
@@ -154,14 +167,16 @@ void search_cells(std::size_t n, const T* x, const T* r, T edge, CellGrid& g, Ne
                         if (std::size_t(j) <= i) continue;
                         if (!g.direct && (g.cx[j] != qx || g.cy[j] != qy || g.cz[j] != qz)) continue;
                         if (!may_touch(xi, get(x, n, std::size_t(j)), r[i], r[j])) continue;
-                        if (c == nl.cap) neighbour_overflow(Index(i), nl.cap, c + 1);
-                        insert_sorted<T>(row, c++, j);  // the canonical order needs partners ascending
+                        if (c < nl.cap) insert_sorted<T>(row, c, j);  // the canonical order needs partners ascending
+                        ++c;
                     }
                 }
             }
         }
-        nl.count[i] = c;
+        over.note(c, i);
+        nl.count[i] = std::min(c, nl.cap);
     }
+    over.check(nl.cap);
 }
 
 template <class T>
@@ -173,9 +188,9 @@ void search_walls(std::size_t n, const T* x, const T* r, std::size_t nw, const T
         for (std::size_t i = 0; i < n; ++i) {
             if (!may_touch_wall(get(x, n, i), r[i], p, nv)) continue;
             Index& c = bl.count[i];
-            if (c == bl.cap)
+            if (c == bl.cap)  // at most one entry per wall: the walls' count always fits
                 throw CapacityError(fmt::format("capacity.wall_contacts_per_particle = {} exceeded: particle {} touches more "
-                                                "walls; set it to at least {}", bl.cap, i, c + 1));
+                                                "walls; set it to {} (the number of walls)", bl.cap, i, nw));
             bl.wall[i * std::size_t(bl.cap) + std::size_t(c++)] = Index(w);
         }
     }
