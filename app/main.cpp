@@ -52,7 +52,7 @@ std::int64_t steps_for(const Scene& scene, std::int64_t steps, double time)
     return steps;
 }
 
-std::vector<std::string> variant_list(const std::string& spec)
+std::vector<std::string> variant_list(const std::string& spec, bool allow_twice = false)
 {
     if (spec == "all") return registry().names();
     std::vector<std::string> out;
@@ -60,7 +60,7 @@ std::vector<std::string> variant_list(const std::string& spec)
     for (char c : spec + ",") {
         if (c == ',') {
             if (!cur.empty()) {
-                if (std::find(out.begin(), out.end(), cur) != out.end()) throw Error(fmt::format("variant '{}' is named twice", cur));
+                if (!allow_twice && std::find(out.begin(), out.end(), cur) != out.end()) throw Error(fmt::format("variant '{}' is named twice", cur));
                 out.push_back(registry().find(cur).name);
             }
             cur.clear();
@@ -193,8 +193,10 @@ int cmd_run(const RunArgs& a)
 int cmd_compare(const std::string& scene, const std::string& variants, std::int64_t steps, double time, bool allow_unstable)
 {
     auto l = load(scene, allow_unstable);
-    const auto names = variant_list(variants);
-    if (names.size() < 2) throw Error("compare needs at least two variants");
+    // A variant may be named twice: two instances must agree too (run-to-run determinism).
+    auto names = variant_list(variants, true);
+    if (variants == "all" && names.size() == 1) names.push_back(names.front());
+    if (names.size() < 2) throw Error("compare needs at least two variants (a variant may be named twice)");
     const std::int64_t k = steps_for(l->scene, steps, time);
     const CompareReport r = compare_variants(names, l->setup, k);
     if (r.difference) {
