@@ -1,0 +1,425 @@
+// The Eigen structure-of-arrays processor: every per-particle vector quantity is one
+// Eigen::Array<double, Dynamic, 3, ColMajor> — one allocation holding the x components of all
+// particles, then all y components, then all z components (three contiguous component arrays, the same
+// layout as the arrays variant and as Fortran stores an (N, 3) array). The predictor and the corrector
+// are whole-array Eigen expressions: gear_predict / gear_correct (gear.hpp) are called once per
+// quantity with V = that array type, and because the storage is one contiguous block, Eigen evaluates
+// each statement as one linear, SIMD-vectorised loop over all 3N components. An element-wise
+// expression performs the same operations in the same order for every element as the scalar loop, so
+// the trajectory is bit-identical to arrays (no Eigen reduction — sum, dot, norm — stands anywhere a
+// fixed summation order matters; minCoeff/maxCoeff in the search are exact in any order).
+//
+// Why N×3 column-major rather than three ArrayXd per quantity: the same memory layout (three
+// contiguous component arrays), but one object per quantity, so one Gear call per quantity instead of
+// three, one allocation, and column c is still a contiguous ArrayXd view (f.col(c) / m + g).
+//
+// The contact phase cannot be written as whole-array expressions: a pair (i, j) gathers two particles'
+// components at stride N, calls the shared scalar contact law, and scatter-adds into f and t. The
+// neighbour store is CSR (row offsets + partner ids), built by a hashed cell search as in arrays,
+// within fixed capacities (scene.capacity) that stop the run with a CapacityError when exceeded.
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+#include <fmt/format.h>
+
+#include "demmat/error.hpp"
+#include "demmat/registry.hpp"
+
+namespace demmat {
+namespace {
+
+using Index = std::int32_t;
+using Arr3 = Eigen::Array<double, Eigen::Dynamic, 3, Eigen::ColMajor>;         // (N, 3): x | y | z
+using Cell3 = Eigen::Array<std::int64_t, Eigen::Dynamic, 3, Eigen::ColMajor>;  // (N, 3) cell coordinates
+using Arr1 = Eigen::ArrayXd;                                                   // (N)
+using IndexArr = Eigen::Array<Index, Eigen::Dynamic, 1>;
+
+// Gather particle i's vector from the three component columns; scatter-add into them.
+inline Vec3d get(const Arr3& a, Eigen::Index i) { return {a.coeff(i, 0), a.coeff(i, 1), a.coeff(i, 2)}; }
+inline void add(Arr3& a, Eigen::Index i, const Vec3d& v)
+{
+    a.coeffRef(i, 0) += v.x;
+    a.coeffRef(i, 1) += v.y;
+    a.coeffRef(i, 2) += v.z;
+}
+
+// ---- contact stores: compressed sparse rows ------------------------------------------------------------
+
+// Candidate partners j > i of particle i are partner[offset[i] .. offset[i+1]), ascending, at most `cap`
+// per particle; the partner array is sized N·cap up front (the paper's fixed capacities).
+struct NeighbourCSR {
+    Index cap = 0;
+    IndexArr offset;   // (N + 1)
+    IndexArr partner;  // (N·cap)
+};
+
+// Walls particle i may touch: wall[offset[i] .. offset[i+1]), in wall order, at most `cap` per particle.
+struct WallCSR {
+    Index cap = 0;
+    IndexArr offset;  // (N + 1)
+    IndexArr wall;    // (N·cap)
+};
+
+// On overflow the search goes on counting (without storing) so the message can give the value that fits
+// (the first particle with the largest count, as in arrays).
+struct Overflow {
+    Index worst = 0, particle = -1;
+    void note(Index count, Eigen::Index i)
+    {
+        if (count > worst) { worst = count; particle = Index(i); }
+    }
+    void check(Index cap) const
+    {
+        if (worst > cap)
+            throw CapacityError(fmt::format("capacity.contacts_per_particle = {} exceeded: particle {} has {} candidate "
+                                            "partners; set it to at least {} in the scene", cap, particle, worst, worst));
+    }
+};
+
+[[noreturn]] void wall_overflow(Eigen::Index i, Index cap, std::size_t walls)
+{
+    // At most one entry per wall: the number of walls always fits.
+    throw CapacityError(fmt::format("capacity.wall_contacts_per_particle = {} exceeded: particle {} touches more "
+                                    "walls; set it to {} (the number of walls)", cap, i, walls));
+}
+
+void insert_sorted(Index* row, Index count, Index j)
+{
+    Index k = count;
+    while (k > 0 && row[k - 1] > j) {
+        row[k] = row[k - 1];
+        --k;
+    }
+    row[k] = j;
+}
+
+// Linked cells over the particles' bounding box with a fixed-size table of list heads (a power of two
+// ≥ 2N): the cell index is the slot when the box has no more cells than that, otherwise cells are hashed
+// and a slot's particles are filtered by their own cell. O(N) memory whatever the domain's extent.
+struct CellTable {
+    IndexArr head;  // (table)
+    IndexArr next;  // (N)
+    Cell3 cell;     // (N, 3)
+    std::int64_t dims[3] = {0, 0, 0};
+    std::uint64_t mask = 0;
+    bool direct = true;
+
+    std::uint64_t slot(std::int64_t ix, std::int64_t iy, std::int64_t iz) const
+    {
+        if (direct) return std::uint64_t(ix + dims[0] * (iy + dims[1] * iz));
+        const std::uint64_t h = std::uint64_t(ix) * 73856093ull ^ std::uint64_t(iy) * 19349663ull ^ std::uint64_t(iz) * 83492791ull;
+        return (h * 0x9e3779b97f4a7c15ull >> 20) & mask;
+    }
+};
+
+// ---- the processor ---------------------------------------------------------------------------------------
+
+template <class M>
+class EigenSoaVariant final : public Variant {
+public:
+    void init(const Setup& setup) override
+    {
+        const State& s = *setup.state;
+        const Scene& scene = *setup.scene;
+        n_ = Eigen::Index(s.size());
+        step_ = s.step;
+        dt_ = scene.dt;
+        gear_ = setup.gear;
+        params_ = setup.contact;
+        g_ = scene.gravity;
+        walls_ = s.walls;
+        cell_ = setup.cell_size;
+        for (Arr3* arr : {&x_, &v_, &a_, &b3_, &b4_, &b5_, &th_, &w_, &al_, &r3_, &r4_, &r5_, &f_, &t_, &acc_, &alc_})
+            arr->setZero(n_, 3);
+        auto load = [this](Arr3& dst, const std::vector<Vec3d>& src) {
+            for (Eigen::Index i = 0; i < n_; ++i)
+                for (int c = 0; c < 3; ++c) dst(i, c) = component(src[std::size_t(i)], c);
+        };
+        load(x_, s.trans.x); load(v_, s.trans.v); load(a_, s.trans.a);
+        load(b3_, s.trans.b3); load(b4_, s.trans.b4); load(b5_, s.trans.b5);
+        load(th_, s.rot.x); load(w_, s.rot.v); load(al_, s.rot.a);
+        load(r3_, s.rot.b3); load(r4_, s.rot.b4); load(r5_, s.rot.b5);
+        r_.resize(n_); m_.resize(n_); I_.resize(n_);
+        for (Eigen::Index i = 0; i < n_; ++i) {
+            r_(i) = s.radius[std::size_t(i)];
+            m_(i) = setup.mass[std::size_t(i)];
+            I_(i) = setup.inertia[std::size_t(i)];
+        }
+        nw_ = walls_.size();
+        wp_.assign(nw_, Vec3d{});
+        place_walls(step_);
+
+        nl_.cap = Index(scene.capacity.contacts_per_particle);
+        nl_.offset.setZero(n_ + 1);
+        nl_.partner.setZero(n_ * nl_.cap);
+        bl_.cap = Index(scene.capacity.wall_contacts_per_particle);
+        bl_.offset.setZero(n_ + 1);
+        bl_.wall.setZero(n_ * bl_.cap);
+        Eigen::Index table = 1;
+        while (table < 2 * n_) table *= 2;
+        grid_.head.setConstant(table, -1);
+        grid_.next.setConstant(n_, -1);
+        grid_.cell.setZero(n_, 3);
+        pp_ = pw_ = candidates_ = 0;
+    }
+
+    void predict(std::int64_t step) override
+    {
+        step_ = step;
+        gear_predict(x_, v_, a_, b3_, b4_, b5_, gear_);  // V = Arr3: five whole-array statements
+        if constexpr (M::rotation) gear_predict(th_, w_, al_, r3_, r4_, r5_, gear_);
+        place_walls(step);
+    }
+
+    void search() override
+    {
+        if (n_ == 0) return;
+        if (cell_ > 0.0) search_cells();
+        else search_all_pairs();
+        search_walls();
+    }
+
+    void forces() override
+    {
+        f_.setZero();
+        t_.setZero();
+        pp_ = 0;
+        pw_ = 0;
+        candidates_ = n_ > 0 ? nl_.offset(n_) : 0;
+        // Pairs in ascending (i, j): for each particle, partners k < p arrive in ascending k from the
+        // earlier rows, then its own row's partners l > p ascending — the canonical order (physics.md §6).
+        for (Eigen::Index i = 0; i < n_; ++i) {
+            const Index begin = nl_.offset(i), end = nl_.offset(i + 1);
+            if (begin == end) continue;
+            const Vec3d xi = get(x_, i), vi = get(v_, i), wi = get(w_, i);
+            const double ri = r_(i), mi = m_(i);
+            for (Index k = begin; k < end; ++k) {
+                const Eigen::Index j = nl_.partner(k);
+                ContactForce<double> c;
+                if (!particle_contact<M>(xi, get(x_, j), vi, get(v_, j), wi, get(w_, j), ri, r_(j), mi, m_(j), params_, c))
+                    continue;
+                ++pp_;
+                add(f_, i, c.f_i);
+                add(f_, j, -c.f_i);
+                if constexpr (M::rotation) {
+                    add(t_, i, c.t_i);
+                    add(t_, j, c.t_j);
+                }
+            }
+        }
+        for (Eigen::Index i = 0; i < n_; ++i) {
+            for (Index k = bl_.offset(i), end = bl_.offset(i + 1); k < end; ++k) {
+                const auto w = std::size_t(bl_.wall(k));
+                ContactForce<double> c;
+                if (!wall_contact<M>(get(x_, i), get(v_, i), get(w_, i), r_(i), m_(i), wp_[w], walls_[w].normal,
+                                     walls_[w].velocity, params_, c))
+                    continue;
+                ++pw_;
+                add(f_, i, c.f_i);
+                if constexpr (M::rotation) add(t_, i, c.t_i);
+            }
+        }
+        // Newton with gravity, whole columns: a = F/m + g (division, then addition, as acceleration()).
+        const double g[3] = {g_.x, g_.y, g_.z};
+        for (int c = 0; c < 3; ++c) {
+            acc_.col(c) = f_.col(c) / m_ + g[c];
+            if constexpr (M::rotation) alc_.col(c) = t_.col(c) / I_;
+        }
+    }
+
+    void correct() override
+    {
+        // Δa = a_c − a_p evaluated into its own storage (in place over a_c, which is not needed after),
+        // never a lazy expression over a_, which gear_correct modifies.
+        acc_ -= a_;
+        gear_correct(x_, v_, a_, b3_, b4_, b5_, acc_, gear_);
+        if constexpr (M::rotation) {
+            alc_ -= al_;
+            gear_correct(th_, w_, al_, r3_, r4_, r5_, alc_, gear_);
+        }
+    }
+
+    void snapshot(Snapshot& out) const override
+    {
+        out.resize(std::size_t(n_));
+        out.step = step_;
+        for (Eigen::Index i = 0; i < n_; ++i) {
+            const auto k = std::size_t(i);
+            out.position[k] = get(x_, i);
+            out.velocity[k] = get(v_, i);
+            out.angular_velocity[k] = get(w_, i);
+            out.force[k] = get(f_, i);
+            out.torque[k] = get(t_, i);
+        }
+    }
+
+    void save(State& out) const override
+    {
+        out.resize(std::size_t(n_));
+        out.step = step_;
+        out.walls = walls_;
+        const Arr3* src[12] = {&x_, &v_, &a_, &b3_, &b4_, &b5_, &th_, &w_, &al_, &r3_, &r4_, &r5_};
+        std::vector<Vec3d>* dst[12] = {&out.trans.x, &out.trans.v, &out.trans.a, &out.trans.b3, &out.trans.b4, &out.trans.b5,
+                                       &out.rot.x,   &out.rot.v,   &out.rot.a,   &out.rot.b3,   &out.rot.b4,   &out.rot.b5};
+        for (int q = 0; q < 12; ++q)
+            for (Eigen::Index i = 0; i < n_; ++i) (*dst[q])[std::size_t(i)] = get(*src[q], i);
+        for (Eigen::Index i = 0; i < n_; ++i) out.radius[std::size_t(i)] = r_(i);
+    }
+
+    ContactCounts counts() const override { return {pp_, pw_, candidates_}; }
+
+    std::size_t memory_bytes() const override
+    {
+        const auto n = std::size_t(n_);
+        return 16 * 3 * n * sizeof(double) + 3 * n * sizeof(double) +
+               std::size_t(nl_.offset.size() + nl_.partner.size() + bl_.offset.size() + bl_.wall.size()) * sizeof(Index) +
+               std::size_t(grid_.head.size() + grid_.next.size()) * sizeof(Index) + std::size_t(grid_.cell.size()) * sizeof(std::int64_t) +
+               wp_.size() * sizeof(Vec3d);
+    }
+
+private:
+    void place_walls(std::int64_t step)
+    {
+        for (std::size_t w = 0; w < nw_; ++w) wp_[w] = walls_[w].point_at(step, dt_);
+    }
+
+    // Every pair (the paper's "no cells"), O(N²).
+    void search_all_pairs()
+    {
+        Index* part = nl_.partner.data();
+        Index used = 0;
+        Overflow over;
+        for (Eigen::Index i = 0; i < n_; ++i) {
+            nl_.offset(i) = used;
+            Index c = 0;
+            const Vec3d xi = get(x_, i);
+            for (Eigen::Index j = i + 1; j < n_; ++j) {
+                if (!may_touch(xi, get(x_, j), r_(i), r_(j))) continue;
+                if (c < nl_.cap) part[used + c] = Index(j);
+                ++c;
+            }
+            over.note(c, i);
+            used += std::min(c, nl_.cap);
+        }
+        nl_.offset(n_) = used;
+        over.check(nl_.cap);
+    }
+
+    void search_cells()
+    {
+        CellTable& g = grid_;
+        // Cell coordinates, whole columns: floor((x − lo)/s), exact whatever the evaluation order.
+        for (int c = 0; c < 3; ++c) {
+            const double lo = x_.col(c).minCoeff();
+            g.cell.col(c) = ((x_.col(c) - lo) / cell_).floor().template cast<std::int64_t>();
+            g.dims[c] = std::max<std::int64_t>(0, g.cell.col(c).maxCoeff()) + 1;
+        }
+        const auto table = std::uint64_t(g.head.size());
+        g.direct = double(g.dims[0]) * double(g.dims[1]) * double(g.dims[2]) <= double(table);
+        g.mask = table - 1;
+        g.head.setConstant(-1);
+        for (Eigen::Index i = n_; i-- > 0;) {  // pushed in descending order: each cell's list ascends
+            const std::uint64_t s = g.slot(g.cell(i, 0), g.cell(i, 1), g.cell(i, 2));
+            g.next(i) = g.head(Eigen::Index(s));
+            g.head(Eigen::Index(s)) = Index(i);
+        }
+        // The hot loop works on raw pointers into the Eigen storage (columns of the cell array).
+        Index* part = nl_.partner.data();
+        const Index* head = g.head.data();
+        const Index* next = g.next.data();
+        const std::int64_t* cx = g.cell.col(0).data();
+        const std::int64_t* cy = g.cell.col(1).data();
+        const std::int64_t* cz = g.cell.col(2).data();
+        Index used = 0;
+        Overflow over;
+        for (Eigen::Index i = 0; i < n_; ++i) {
+            nl_.offset(i) = used;
+            Index* row = part + used;
+            Index c = 0;
+            const Vec3d xi = get(x_, i);
+            const double ri = r_(i);
+            const std::int64_t ci[3] = {cx[i], cy[i], cz[i]};
+            for (std::int64_t dz = -1; dz <= 1; ++dz) {
+                const std::int64_t qz = ci[2] + dz;
+                if (qz < 0 || qz >= g.dims[2]) continue;
+                for (std::int64_t dy = -1; dy <= 1; ++dy) {
+                    const std::int64_t qy = ci[1] + dy;
+                    if (qy < 0 || qy >= g.dims[1]) continue;
+                    for (std::int64_t dx = -1; dx <= 1; ++dx) {
+                        const std::int64_t qx = ci[0] + dx;
+                        if (qx < 0 || qx >= g.dims[0]) continue;
+                        for (Index j = head[g.slot(qx, qy, qz)]; j >= 0; j = next[j]) {
+                            if (Eigen::Index(j) <= i) continue;
+                            if (!g.direct && (cx[j] != qx || cy[j] != qy || cz[j] != qz)) continue;
+                            if (!may_touch(xi, get(x_, j), ri, r_(j))) continue;
+                            if (c < nl_.cap) insert_sorted(row, c, j);  // the canonical order needs partners ascending
+                            ++c;
+                        }
+                    }
+                }
+            }
+            over.note(c, i);
+            used += std::min(c, nl_.cap);
+        }
+        nl_.offset(n_) = used;
+        over.check(nl_.cap);
+    }
+
+    void search_walls()
+    {
+        // Rows are per particle (CSR), so particles are the outer loop here; an overflow names the
+        // particle arrays (walls outer) would name: the lowest id at the lowest overflowing wall.
+        Index used = 0;
+        std::size_t over_wall = nw_;
+        Eigen::Index over_particle = -1;
+        for (Eigen::Index i = 0; i < n_; ++i) {
+            bl_.offset(i) = used;
+            Index c = 0;
+            const Vec3d xi = get(x_, i);
+            for (std::size_t w = 0; w < nw_; ++w) {
+                if (!may_touch_wall(xi, r_(i), wp_[w], walls_[w].normal)) continue;
+                if (c == bl_.cap) {
+                    if (w < over_wall) { over_wall = w; over_particle = i; }
+                    break;
+                }
+                bl_.wall(used + c++) = Index(w);
+            }
+            used += c;
+        }
+        bl_.offset(n_) = used;
+        if (over_particle >= 0) wall_overflow(over_particle, bl_.cap, nw_);
+    }
+
+    Eigen::Index n_ = 0;
+    std::size_t nw_ = 0;
+    std::int64_t step_ = 0;
+    double dt_ = 0.0;
+    double cell_ = 0.0;
+    GearCoefficients<double> gear_;
+    ContactParams<double> params_;
+    Vec3d g_;
+    std::vector<Wall> walls_;
+    std::vector<Vec3d> wp_;                                          // wall points at the current step
+    Arr3 x_, v_, a_, b3_, b4_, b5_;                                  // translation Gear values
+    Arr3 th_, w_, al_, r3_, r4_, r5_;                                // rotation Gear values
+    Arr3 f_, t_;                                                     // contact force and torque sums
+    Arr3 acc_, alc_;                                                 // a_c, α_c; Δa, Δα in correct()
+    Arr1 r_, m_, I_;                                                 // radius, mass, inertia
+    NeighbourCSR nl_;
+    WallCSR bl_;
+    CellTable grid_;
+    std::int64_t pp_ = 0, pw_ = 0, candidates_ = 0;
+};
+
+} // namespace
+
+void register_variant_eigen_soa(Registry& r)
+{
+    r.add({"eigen_soa", "Eigen structure of arrays, whole-array predictor and corrector",
+           [] { return std::make_unique<EigenSoaVariant<FullModel>>(); }});
+}
+
+} // namespace demmat
