@@ -398,7 +398,9 @@ int main(int argc, char** argv)
 
     try {
         if (*list) {
-            for (const auto& v : registry().all()) std::cout << fmt::format("{:<16} {}\n", v.name, v.summary);
+            std::size_t width = 0;
+            for (const auto& v : registry().all()) width = std::max(width, v.name.size());
+            for (const auto& v : registry().all()) std::cout << fmt::format("{:<{}}  {}\n", v.name, width, v.summary);
             return 0;
         }
         if (*scene) return cmd_scene(sa);

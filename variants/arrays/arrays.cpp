@@ -18,14 +18,18 @@ using Index = std::int32_t;
 
 // ---- predictor and corrector: one loop over all 3N components --------------------------------------
 
+// The six arrays never alias (Fortran assumes as much of its dummy arguments); __restrict says so, and
+// lets the compiler vectorise these loops (the element-wise operations, and so the bits, are the same).
 template <class T>
-void gear_predictor(std::size_t n3, T* x, T* v, T* a, T* b3, T* b4, const T* b5, const GearCoefficients<T>& k)
+void gear_predictor(std::size_t n3, T* __restrict x, T* __restrict v, T* __restrict a, T* __restrict b3, T* __restrict b4,
+                    const T* __restrict b5, const GearCoefficients<T>& k)
 {
     for (std::size_t e = 0; e < n3; ++e) gear_predict(x[e], v[e], a[e], b3[e], b4[e], b5[e], k);
 }
 
 template <class T>
-void gear_corrector(std::size_t n3, T* x, T* v, T* a, T* b3, T* b4, T* b5, const T* a_new, const GearCoefficients<T>& k)
+void gear_corrector(std::size_t n3, T* __restrict x, T* __restrict v, T* __restrict a, T* __restrict b3, T* __restrict b4,
+                    T* __restrict b5, const T* __restrict a_new, const GearCoefficients<T>& k)
 {
     for (std::size_t e = 0; e < n3; ++e) {
         const T da = a_new[e] - a[e];

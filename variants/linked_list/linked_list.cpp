@@ -1,19 +1,25 @@
 // The linked-list contact store: the design the DEMMAT paper rejected ("the linked list method based
-// on pointers and target variables", because allocating and freeing list nodes as contacts come and go
-// costs CPU time every step). The particles' state is held exactly as in the arrays variant (flat
+// on pointers and target variables", because a list rebuilt every step allocates and frees a node for
+// every contact every step). The particles' state is held exactly as in the arrays variant (flat
 // arrays, column by column); only the contact store differs, so a comparison with arrays isolates it.
 //
-// The store is persistent: particle i owns a singly linked list of nodes {partner j > i, next}, kept
-// sorted by partner id, and a second list of its wall contacts, sorted by wall index. Each step the
-// search finds the current candidate set of every particle and merges it into the lists: nodes of pairs
-// that left are unlinked and released, nodes of new pairs are acquired and linked in sorted position,
-// and pairs that persist keep their node (where contact history would live). Walking particles in id
-// order and each list in order is the canonical summation order of physics.md §6.
+// Particle i owns a singly linked list of nodes {partner j > i, next}, kept sorted by partner id, and a
+// second list of its wall contacts, sorted by wall index. Each step the search finds the current
+// candidate set of every particle and merges it into the lists: nodes of pairs that left are unlinked
+// and released, nodes of new pairs are acquired and linked in sorted position, and pairs that persist
+// keep their node (where contact history would live). Walking particles in id order and each list in
+// order is the canonical summation order of physics.md §6, so every mode gives the same sorted lists
+// and a trajectory bit-identical to arrays.
 //
-// Where the nodes come from is a policy (a template parameter), one code for both registered variants:
-//   linked_list       every node from operator new, every dropped node back to operator delete;
-//   linked_list_pool  nodes from blocks allocated up front (grown by doubling when exhausted), dropped
-//                     nodes kept on a free list and handed out again; the blocks are freed at the end.
+// Two compile-time policies of one template give the three registered variants and what each measures:
+//   linked_list_rebuild  Rebuild = true, nodes from new/delete: every step every node of every list is
+//                        deleted and a fresh one new'ed per candidate, the paper's rebuilt list, so it
+//                        costs an allocation and a free per contact per step;
+//   linked_list          persistent lists, nodes from new/delete: allocator calls only for the few
+//                        contacts that appear or disappear each step;
+//   linked_list_pool     persistent lists, nodes from blocks allocated up front (doubled when exhausted)
+//                        and recycled through a free list: no allocator calls once warm, so what remains
+//                        of the difference to arrays is pointer chasing.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -220,7 +226,9 @@ inline void insert_sorted(std::vector<Index>& row, Index j)
 
 // ---- the processor ---------------------------------------------------------------------------------
 
-template <class T, class M, class Nodes>
+// Rebuild: empty every list (release all nodes) at the start of each search, so the merge acquires a
+// fresh node for every candidate; otherwise the lists persist from step to step.
+template <class T, class M, class Nodes, bool Rebuild = false>
 class LinkedListVariant final : public Variant {
 public:
     LinkedListVariant() = default;
@@ -293,6 +301,7 @@ public:
 
     void search() override
     {
+        if constexpr (Rebuild) free_lists();
         if (cell_ > T(0)) search_cells();
         else search_all_pairs();
         search_walls();
@@ -511,6 +520,8 @@ void register_variant_linked_list(Registry& r)
            [] { return std::make_unique<LinkedListVariant<double, FullModel, HeapNodes>>(); }});
     r.add({"linked_list_pool", "arrays state; persistent per-particle linked lists of contacts, nodes from a recycled pool",
            [] { return std::make_unique<LinkedListVariant<double, FullModel, PoolNodes>>(); }});
+    r.add({"linked_list_rebuild", "arrays state; per-particle linked lists rebuilt every step, a new/delete per contact",
+           [] { return std::make_unique<LinkedListVariant<double, FullModel, HeapNodes, true>>(); }});
 }
 
 } // namespace demmat
