@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 
 #include "demmat/error.hpp"
+#include "demmat/linked_cells.hpp"
 #include "demmat/registry.hpp"
 
 namespace demmat {
@@ -63,37 +64,11 @@ struct BoundaryList {
     std::vector<Index> wall;   // (N, cap)
 };
 
-// On overflow the search goes on counting (without storing) so the message can give the value that fits.
-struct Overflow {
-    Index worst = 0, particle = -1;
-    void note(Index count, std::size_t i)
-    {
-        if (count > worst) { worst = count; particle = Index(i); }
-    }
-    void check(Index cap) const
-    {
-        if (worst > cap)
-            throw CapacityError(fmt::format("capacity.contacts_per_particle = {} exceeded: particle {} has {} candidate "
-                                            "partners; set it to at least {} in the scene", cap, particle, worst, worst));
-    }
-};
-
-template <class T>
-void insert_sorted(Index* row, Index count, Index j)
-{
-    Index k = count;
-    while (k > 0 && row[k - 1] > j) {
-        row[k] = row[k - 1];
-        --k;
-    }
-    row[k] = j;
-}
-
 // Every pair (the paper's "no cells"), O(N²).
 template <class T>
 void search_all_pairs(std::size_t n, const T* x, const T* r, NeighbourList& nl)
 {
-    Overflow over;
+    CandidateOverflow over;
     for (std::size_t i = 0; i < n; ++i) {
         Index c = 0;
         Index* row = &nl.partner[i * std::size_t(nl.cap)];
@@ -109,74 +84,23 @@ void search_all_pairs(std::size_t n, const T* x, const T* r, NeighbourList& nl)
     over.check(nl.cap);
 }
 
-// Linked cells: cubic cells of edge s over the particles' bounding box, each cell a linked list
-// (head, next) as in the Fortran original. The table of list heads has a fixed size (a power of two
-// ≥ 2N): when the box has no more cells than that, a cell's index is its slot; otherwise cells are
-// hashed into it, and a particle is taken from a slot only if its own cell is the one visited. Memory
-// is thus O(N) whatever the extent of the domain (the paper's 2 m box would need 200³ cells).
-struct CellGrid {
-    std::vector<Index> head;              // (table)
-    std::vector<Index> next;              // (N)
-    std::vector<std::int64_t> cx, cy, cz; // (N) integer cell coordinates
-    std::int64_t dims[3] = {0, 0, 0};
-    std::uint64_t mask = 0;
-    bool direct = true;
-
-    std::uint64_t slot(std::int64_t ix, std::int64_t iy, std::int64_t iz) const
-    {
-        if (direct) return std::uint64_t(ix + dims[0] * (iy + dims[1] * iz));
-        const std::uint64_t h = std::uint64_t(ix) * 73856093ull ^ std::uint64_t(iy) * 19349663ull ^ std::uint64_t(iz) * 83492791ull;
-        return (h * 0x9e3779b97f4a7c15ull >> 20) & mask;
-    }
-};
-
+// Linked cells (common/linked_cells.hpp); partners j > i stored in ascending order, as the canonical
+// order needs. On overflow the search goes on counting so the message can give the value that fits.
 template <class T>
-void search_cells(std::size_t n, const T* x, const T* r, T edge, CellGrid& g, NeighbourList& nl)
+void search_cells(std::size_t n, const T* x, const T* r, T edge, LinkedCells& cells, NeighbourList& nl)
 {
-    T lo[3];
-    for (int c = 0; c < 3; ++c) lo[c] = *std::min_element(x + c * n, x + (c + 1) * n);
-    std::int64_t* cc[3] = {g.cx.data(), g.cy.data(), g.cz.data()};
-    for (int c = 0; c < 3; ++c) {
-        std::int64_t hi = 0;
-        for (std::size_t i = 0; i < n; ++i) {
-            cc[c][i] = std::int64_t(std::floor((x[c * n + i] - lo[c]) / edge));
-            hi = std::max(hi, cc[c][i]);
-        }
-        g.dims[c] = hi + 1;
-    }
-    const auto table = std::uint64_t(g.head.size());
-    g.direct = double(g.dims[0]) * double(g.dims[1]) * double(g.dims[2]) <= double(table);
-    g.mask = table - 1;
-    std::fill(g.head.begin(), g.head.end(), Index(-1));
-    for (std::size_t i = n; i-- > 0;) {  // pushed in descending order: each cell's list ascends
-        const std::uint64_t s = g.slot(g.cx[i], g.cy[i], g.cz[i]);
-        g.next[i] = g.head[s];
-        g.head[s] = Index(i);
-    }
-    Overflow over;
+    cells.build(n, x, x + n, x + 2 * n, edge);
+    CandidateOverflow over;
     for (std::size_t i = 0; i < n; ++i) {
         Index c = 0;
         Index* row = &nl.partner[i * std::size_t(nl.cap)];
         const Vec3<T> xi = get(x, n, i);
-        for (std::int64_t dz = -1; dz <= 1; ++dz) {
-            const std::int64_t qz = g.cz[i] + dz;
-            if (qz < 0 || qz >= g.dims[2]) continue;
-            for (std::int64_t dy = -1; dy <= 1; ++dy) {
-                const std::int64_t qy = g.cy[i] + dy;
-                if (qy < 0 || qy >= g.dims[1]) continue;
-                for (std::int64_t dx = -1; dx <= 1; ++dx) {
-                    const std::int64_t qx = g.cx[i] + dx;
-                    if (qx < 0 || qx >= g.dims[0]) continue;
-                    for (Index j = g.head[g.slot(qx, qy, qz)]; j >= 0; j = g.next[j]) {
-                        if (std::size_t(j) <= i) continue;
-                        if (!g.direct && (g.cx[j] != qx || g.cy[j] != qy || g.cz[j] != qz)) continue;
-                        if (!may_touch(xi, get(x, n, std::size_t(j)), r[i], r[j])) continue;
-                        if (c < nl.cap) insert_sorted<T>(row, c, j);  // the canonical order needs partners ascending
-                        ++c;
-                    }
-                }
-            }
-        }
+        const T ri = r[i];
+        cells.for_each_above(i, [&](std::size_t j) {
+            if (!may_touch(xi, get(x, n, j), ri, r[j])) return;
+            if (c < nl.cap) insert_ascending(row, c, Index(j));
+            ++c;
+        });
         over.note(c, i);
         nl.count[i] = std::min(c, nl.cap);
     }
@@ -247,11 +171,7 @@ public:
         bl_.cap = Index(scene.capacity.wall_contacts_per_particle);
         bl_.count.assign(n_, 0);
         bl_.wall.assign(n_ * std::size_t(bl_.cap), 0);
-        std::size_t table = 1;
-        while (table < 2 * n_) table *= 2;
-        grid_.head.assign(table, -1);
-        grid_.next.assign(n_, -1);
-        grid_.cx.assign(n_, 0); grid_.cy.assign(n_, 0); grid_.cz.assign(n_, 0);
+        cells_.reserve(n_);
     }
 
     void predict(std::int64_t step) override
@@ -265,7 +185,7 @@ public:
 
     void search() override
     {
-        if (cell_ > T(0)) search_cells(n_, x_.data(), r_.data(), cell_, grid_, nl_);
+        if (cell_ > T(0)) search_cells(n_, x_.data(), r_.data(), cell_, cells_, nl_);
         else search_all_pairs(n_, x_.data(), r_.data(), nl_);
         search_walls(n_, x_.data(), r_.data(), nw_, wp_.data(), wn_.data(), bl_);
     }
@@ -357,7 +277,7 @@ public:
     std::size_t memory_bytes() const override
     {
         return 19 * 3 * n_ * sizeof(T) + (nl_.partner.size() + nl_.count.size() + bl_.wall.size() + bl_.count.size()) * sizeof(Index) +
-               grid_.head.size() * sizeof(Index) + grid_.next.size() * sizeof(Index) + 3 * n_ * sizeof(std::int64_t);
+               cells_.memory_bytes();
     }
 
 private:
@@ -383,7 +303,7 @@ private:
     std::vector<T> wp_, wn_, wv_;                                           // (3, walls)
     NeighbourList nl_;
     BoundaryList bl_;
-    CellGrid grid_;
+    LinkedCells cells_;
     std::int64_t pp_ = 0, pw_ = 0, candidates_ = 0;
 };
 

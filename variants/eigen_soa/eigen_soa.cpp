@@ -26,6 +26,7 @@
 #include <fmt/format.h>
 
 #include "demmat/error.hpp"
+#include "demmat/linked_cells.hpp"
 #include "demmat/registry.hpp"
 
 namespace demmat {
@@ -63,57 +64,12 @@ struct WallCSR {
     IndexArr wall;    // (N·cap)
 };
 
-// On overflow the search goes on counting (without storing) so the message can give the value that fits
-// (the first particle with the largest count, as in arrays).
-struct Overflow {
-    Index worst = 0, particle = -1;
-    void note(Index count, Eigen::Index i)
-    {
-        if (count > worst) { worst = count; particle = Index(i); }
-    }
-    void check(Index cap) const
-    {
-        if (worst > cap)
-            throw CapacityError(fmt::format("capacity.contacts_per_particle = {} exceeded: particle {} has {} candidate "
-                                            "partners; set it to at least {} in the scene", cap, particle, worst, worst));
-    }
-};
-
 [[noreturn]] void wall_overflow(Eigen::Index i, Index cap, std::size_t walls)
 {
     // At most one entry per wall: the number of walls always fits.
     throw CapacityError(fmt::format("capacity.wall_contacts_per_particle = {} exceeded: particle {} touches more "
                                     "walls; set it to {} (the number of walls)", cap, i, walls));
 }
-
-void insert_sorted(Index* row, Index count, Index j)
-{
-    Index k = count;
-    while (k > 0 && row[k - 1] > j) {
-        row[k] = row[k - 1];
-        --k;
-    }
-    row[k] = j;
-}
-
-// Linked cells over the particles' bounding box with a fixed-size table of list heads (a power of two
-// ≥ 2N): the cell index is the slot when the box has no more cells than that, otherwise cells are hashed
-// and a slot's particles are filtered by their own cell. O(N) memory whatever the domain's extent.
-struct CellTable {
-    IndexArr head;  // (table)
-    IndexArr next;  // (N)
-    Cell3 cell;     // (N, 3)
-    std::int64_t dims[3] = {0, 0, 0};
-    std::uint64_t mask = 0;
-    bool direct = true;
-
-    std::uint64_t slot(std::int64_t ix, std::int64_t iy, std::int64_t iz) const
-    {
-        if (direct) return std::uint64_t(ix + dims[0] * (iy + dims[1] * iz));
-        const std::uint64_t h = std::uint64_t(ix) * 73856093ull ^ std::uint64_t(iy) * 19349663ull ^ std::uint64_t(iz) * 83492791ull;
-        return (h * 0x9e3779b97f4a7c15ull >> 20) & mask;
-    }
-};
 
 // ---- the processor ---------------------------------------------------------------------------------------
 
@@ -158,11 +114,7 @@ public:
         bl_.cap = Index(scene.capacity.wall_contacts_per_particle);
         bl_.offset.setZero(n_ + 1);
         bl_.wall.setZero(n_ * bl_.cap);
-        Eigen::Index table = 1;
-        while (table < 2 * n_) table *= 2;
-        grid_.head.setConstant(table, -1);
-        grid_.next.setConstant(n_, -1);
-        grid_.cell.setZero(n_, 3);
+        cells_.reserve(std::size_t(n_));
         pp_ = pw_ = candidates_ = 0;
     }
 
@@ -276,7 +228,7 @@ public:
         const auto n = std::size_t(n_);
         return 16 * 3 * n * sizeof(double) + 3 * n * sizeof(double) +
                std::size_t(nl_.offset.size() + nl_.partner.size() + bl_.offset.size() + bl_.wall.size()) * sizeof(Index) +
-               std::size_t(grid_.head.size() + grid_.next.size()) * sizeof(Index) + std::size_t(grid_.cell.size()) * sizeof(std::int64_t) +
+               cells_.memory_bytes() +
                wp_.size() * sizeof(Vec3d);
     }
 
@@ -291,7 +243,7 @@ private:
     {
         Index* part = nl_.partner.data();
         Index used = 0;
-        Overflow over;
+        CandidateOverflow over;
         for (Eigen::Index i = 0; i < n_; ++i) {
             nl_.offset(i) = used;
             Index c = 0;
@@ -308,60 +260,26 @@ private:
         over.check(nl_.cap);
     }
 
+    // Linked cells (common/linked_cells.hpp) on the three position columns; partners j > i stored
+    // ascending in the particle's compressed row, as the canonical order needs.
     void search_cells()
     {
-        CellTable& g = grid_;
-        // Cell coordinates, whole columns: floor((x − lo)/s), exact whatever the evaluation order.
-        for (int c = 0; c < 3; ++c) {
-            const double lo = x_.col(c).minCoeff();
-            g.cell.col(c) = ((x_.col(c) - lo) / cell_).floor().template cast<std::int64_t>();
-            g.dims[c] = std::max<std::int64_t>(0, g.cell.col(c).maxCoeff()) + 1;
-        }
-        const auto table = std::uint64_t(g.head.size());
-        g.direct = double(g.dims[0]) * double(g.dims[1]) * double(g.dims[2]) <= double(table);
-        g.mask = table - 1;
-        g.head.setConstant(-1);
-        for (Eigen::Index i = n_; i-- > 0;) {  // pushed in descending order: each cell's list ascends
-            const std::uint64_t s = g.slot(g.cell(i, 0), g.cell(i, 1), g.cell(i, 2));
-            g.next(i) = g.head(Eigen::Index(s));
-            g.head(Eigen::Index(s)) = Index(i);
-        }
-        // The hot loop works on raw pointers into the Eigen storage (columns of the cell array).
+        cells_.build(std::size_t(n_), x_.col(0).data(), x_.col(1).data(), x_.col(2).data(), cell_);
         Index* part = nl_.partner.data();
-        const Index* head = g.head.data();
-        const Index* next = g.next.data();
-        const std::int64_t* cx = g.cell.col(0).data();
-        const std::int64_t* cy = g.cell.col(1).data();
-        const std::int64_t* cz = g.cell.col(2).data();
         Index used = 0;
-        Overflow over;
+        CandidateOverflow over;
         for (Eigen::Index i = 0; i < n_; ++i) {
             nl_.offset(i) = used;
             Index* row = part + used;
             Index c = 0;
             const Vec3d xi = get(x_, i);
             const double ri = r_(i);
-            const std::int64_t ci[3] = {cx[i], cy[i], cz[i]};
-            for (std::int64_t dz = -1; dz <= 1; ++dz) {
-                const std::int64_t qz = ci[2] + dz;
-                if (qz < 0 || qz >= g.dims[2]) continue;
-                for (std::int64_t dy = -1; dy <= 1; ++dy) {
-                    const std::int64_t qy = ci[1] + dy;
-                    if (qy < 0 || qy >= g.dims[1]) continue;
-                    for (std::int64_t dx = -1; dx <= 1; ++dx) {
-                        const std::int64_t qx = ci[0] + dx;
-                        if (qx < 0 || qx >= g.dims[0]) continue;
-                        for (Index j = head[g.slot(qx, qy, qz)]; j >= 0; j = next[j]) {
-                            if (Eigen::Index(j) <= i) continue;
-                            if (!g.direct && (cx[j] != qx || cy[j] != qy || cz[j] != qz)) continue;
-                            if (!may_touch(xi, get(x_, j), ri, r_(j))) continue;
-                            if (c < nl_.cap) insert_sorted(row, c, j);  // the canonical order needs partners ascending
-                            ++c;
-                        }
-                    }
-                }
-            }
-            over.note(c, i);
+            cells_.for_each_above(std::size_t(i), [&](std::size_t j) {
+                if (!may_touch(xi, get(x_, Eigen::Index(j)), ri, r_(Eigen::Index(j)))) return;
+                if (c < nl_.cap) insert_ascending(row, c, Index(j));
+                ++c;
+            });
+            over.note(c, std::size_t(i));
             used += std::min(c, nl_.cap);
         }
         nl_.offset(n_) = used;
@@ -410,7 +328,7 @@ private:
     Arr1 r_, m_, I_;                                                 // radius, mass, inertia
     NeighbourCSR nl_;
     WallCSR bl_;
-    CellTable grid_;
+    LinkedCells cells_;
     std::int64_t pp_ = 0, pw_ = 0, candidates_ = 0;
 };
 

@@ -27,6 +27,7 @@
 #include <memory>
 #include <vector>
 
+#include "demmat/linked_cells.hpp"
 #include "demmat/registry.hpp"
 
 namespace demmat {
@@ -169,61 +170,6 @@ void add(T* a, std::size_t n, std::size_t i, const Vec3<T>& v)
     a[2 * n + i] += v.z;
 }
 
-// ---- cell grid (the arrays variant's hashed linked cells) -------------------------------------------
-
-struct CellGrid {
-    std::vector<Index> head;               // (table)
-    std::vector<Index> next;               // (N)
-    std::vector<std::int64_t> cx, cy, cz;  // (N) integer cell coordinates
-    std::int64_t dims[3] = {0, 0, 0};
-    std::uint64_t mask = 0;
-    bool direct = true;
-
-    std::uint64_t slot(std::int64_t ix, std::int64_t iy, std::int64_t iz) const
-    {
-        if (direct) return std::uint64_t(ix + dims[0] * (iy + dims[1] * iz));
-        const std::uint64_t h = std::uint64_t(ix) * 73856093ull ^ std::uint64_t(iy) * 19349663ull ^ std::uint64_t(iz) * 83492791ull;
-        return (h * 0x9e3779b97f4a7c15ull >> 20) & mask;
-    }
-
-    template <class T>
-    void bin(std::size_t n, const T* x, T edge)
-    {
-        T lo[3];
-        for (int c = 0; c < 3; ++c) lo[c] = *std::min_element(x + c * n, x + (c + 1) * n);
-        std::int64_t* cc[3] = {cx.data(), cy.data(), cz.data()};
-        for (int c = 0; c < 3; ++c) {
-            std::int64_t hi = 0;
-            for (std::size_t i = 0; i < n; ++i) {
-                cc[c][i] = std::int64_t(std::floor((x[c * n + i] - lo[c]) / edge));
-                hi = std::max(hi, cc[c][i]);
-            }
-            dims[c] = hi + 1;
-        }
-        const auto table = std::uint64_t(head.size());
-        direct = double(dims[0]) * double(dims[1]) * double(dims[2]) <= double(table);
-        mask = table - 1;
-        std::fill(head.begin(), head.end(), Index(-1));
-        for (std::size_t i = n; i-- > 0;) {
-            const std::uint64_t s = slot(cx[i], cy[i], cz[i]);
-            next[i] = head[s];
-            head[s] = Index(i);
-        }
-    }
-};
-
-// Candidates j > i gathered in a scratch row, kept ascending by insertion (a particle has few).
-inline void insert_sorted(std::vector<Index>& row, Index j)
-{
-    row.push_back(j);
-    std::size_t k = row.size() - 1;
-    while (k > 0 && row[k - 1] > j) {
-        row[k] = row[k - 1];
-        --k;
-    }
-    row[k] = j;
-}
-
 // ---- the processor ---------------------------------------------------------------------------------
 
 // Rebuild: empty every list (release all nodes) at the start of each search, so the merge acquires a
@@ -282,11 +228,7 @@ public:
         nodes_.reserve(4 * n_ + 64);
         scratch_.clear();
         scratch_.reserve(64);
-        std::size_t table = 1;
-        while (table < 2 * n_) table *= 2;
-        grid_.head.assign(table, -1);
-        grid_.next.assign(n_, -1);
-        grid_.cx.assign(n_, 0); grid_.cy.assign(n_, 0); grid_.cz.assign(n_, 0);
+        cells_.reserve(n_);
         pp_ = pw_ = candidates_ = 0;
     }
 
@@ -395,8 +337,7 @@ public:
     std::size_t memory_bytes() const override
     {
         return 19 * 3 * n_ * sizeof(T) + (pp_head_.size() + pw_head_.size()) * sizeof(Node*) + nodes_.bytes(pp_live_ + pw_live_) +
-               scratch_.capacity() * sizeof(Index) + grid_.head.size() * sizeof(Index) + grid_.next.size() * sizeof(Index) +
-               3 * n_ * sizeof(std::int64_t);
+               scratch_.capacity() * sizeof(Index) + cells_.memory_bytes();
     }
 
 private:
@@ -430,33 +371,21 @@ private:
         }
     }
 
+    // Linked cells (common/linked_cells.hpp); a particle's candidates j > i gathered ascending in a
+    // scratch row, then merged into its list.
     void search_cells()
     {
         const std::size_t n = n_;
         const T* x = x_.data();
-        CellGrid& g = grid_;
-        g.bin(n, x, cell_);
+        cells_.build(n, x, x + n, x + 2 * n, cell_);
         for (std::size_t i = 0; i < n; ++i) {
             scratch_.clear();
             const Vec3<T> xi = get(x, n, i);
-            for (std::int64_t dz = -1; dz <= 1; ++dz) {
-                const std::int64_t qz = g.cz[i] + dz;
-                if (qz < 0 || qz >= g.dims[2]) continue;
-                for (std::int64_t dy = -1; dy <= 1; ++dy) {
-                    const std::int64_t qy = g.cy[i] + dy;
-                    if (qy < 0 || qy >= g.dims[1]) continue;
-                    for (std::int64_t dx = -1; dx <= 1; ++dx) {
-                        const std::int64_t qx = g.cx[i] + dx;
-                        if (qx < 0 || qx >= g.dims[0]) continue;
-                        for (Index j = g.head[g.slot(qx, qy, qz)]; j >= 0; j = g.next[j]) {
-                            if (std::size_t(j) <= i) continue;
-                            if (!g.direct && (g.cx[j] != qx || g.cy[j] != qy || g.cz[j] != qz)) continue;
-                            if (!may_touch(xi, get(x, n, std::size_t(j)), r_[i], r_[j])) continue;
-                            insert_sorted(scratch_, j);
-                        }
-                    }
-                }
-            }
+            cells_.for_each_above(i, [&](std::size_t j) {
+                if (!may_touch(xi, get(x, n, j), r_[i], r_[j])) return;
+                scratch_.push_back(Index(j));
+                insert_ascending(scratch_.data(), std::int64_t(scratch_.size()) - 1, Index(j));
+            });
             update_pairs(i);
         }
     }
@@ -508,7 +437,7 @@ private:
     std::vector<Node*> pw_head_;  // (N) particle i's walls, ascending
     std::size_t pp_live_ = 0, pw_live_ = 0;
     std::vector<Index> scratch_;  // one particle's candidates during the search
-    CellGrid grid_;
+    LinkedCells cells_;
     std::int64_t pp_ = 0, pw_ = 0, candidates_ = 0;
 };
 
