@@ -5,7 +5,7 @@ Writes a grouped bar chart (log scale, median with min–max whiskers over the i
 and a CSV table of seconds per step and of each variant's ratio to the arrays variant per phase.
 Reads structured fields only; nothing is parsed out of labels.
 
-Usage: /usr/bin/python3 analysis/plot_phases.py BENCH.json --figure OUT.png --table OUT.csv
+Usage: /usr/bin/python3 analysis/plot_phases.py BENCH.json --figure OUT.png --table OUT.csv [--markdown OUT.md]
 """
 import argparse
 import json
@@ -84,11 +84,29 @@ def figure(stats, order, bench, path):
     atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=150, format="png"))
 
 
+def markdown(stats, order, bench):
+    """A Markdown table of µs per step (median) and the ratio to arrays, with the provenance line."""
+    phases = ["predict", "search", "forces", "correct", "search_plus_forces", "total"]
+    head = "| variant | " + " | ".join(p.replace("_", " ") for p in phases) + " | µs per particle-step |"
+    lines = [head, "|" + "---|" * (len(phases) + 2)]
+    n = bench["scene"]["particles"]
+    for v in order:
+        sub = stats[stats.variant == v].set_index("phase")
+        cells = []
+        for p in phases:
+            med = sub.loc[p, "median"] * 1e6
+            ratio = sub.loc[p, "ratio_to_arrays"] if "ratio_to_arrays" in sub else float("nan")
+            cells.append(f"{med:.1f} ({ratio:.2f}×)")
+        lines.append(f"| {v} | " + " | ".join(cells) + f" | {sub.loc['total', 'median'] / n * 1e6:.3f} |")
+    return ("Median µs per step (ratio to arrays). " + caption(bench).replace("\n", ". ") + "\n\n" + "\n".join(lines) + "\n")
+
+
 def main(argv):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("bench", help="JSON written by `demmat bench --json`")
     ap.add_argument("--figure", required=True)
     ap.add_argument("--table", required=True)
+    ap.add_argument("--markdown", help="also write the table as Markdown")
     a = ap.parse_args(argv)
     with open(a.bench) as f:
         bench = json.load(f)
@@ -96,6 +114,9 @@ def main(argv):
     stats = table(tidy_samples(bench), order)
     atomic_write(a.table, lambda tmp: stats.to_csv(tmp, index=False, float_format="%.6g"))
     figure(stats, order, bench, a.figure)
+    if a.markdown:
+        text = markdown(stats, order, bench)
+        atomic_write(a.markdown, lambda tmp: open(tmp, "w").write(text))
     print(stats.to_string(index=False, float_format=lambda x: f"{x:.4g}"))
 
 

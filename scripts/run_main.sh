@@ -48,5 +48,5 @@ $demmat bench "$comp" --variants all --steps "$steps" --repetitions "$reps" --js
 
 echo "== analysis"
 /usr/bin/python3 analysis/plot_phases.py "$json" --figure results/figures/phases_compression_${n}.png \
-  --table results/main/phases_compression_${n}.csv
+  --table results/main/phases_compression_${n}.csv --markdown results/main/phases_compression_${n}.md
 echo "results: $json, results/main/phases_compression_${n}.csv, results/figures/phases_compression_${n}.png"
