@@ -75,6 +75,25 @@ Driver::Driver(Variant& variant, const Setup& setup) : variant_(variant), setup_
 
 void Driver::step()
 {
+    try {
+        timed_step();
+    } catch (const InstabilityError& e) {
+        if (e.step() >= 0) throw;
+        // Raised inside a phase (e.g. the cell search met a runaway position): add the step and the hint.
+        throw InstabilityError(fmt::format("step {}: {} ({})", step_, e.what(), stability_hint()), step_, e.particle());
+    }
+}
+
+std::string Driver::stability_hint() const
+{
+    const State& st = *setup_.state;
+    const double rmin = st.radius.empty() ? 0.0 : *std::min_element(st.radius.begin(), st.radius.end());
+    return fmt::format("Δt = {:g} s; the Rayleigh time of the smallest particle is {:.3g} s, a step of at most 0.2 of it is "
+                       "usually stable", setup_.scene->dt, rayleigh_time(setup_.scene->material, rmin));
+}
+
+void Driver::timed_step()
+{
     using clock = std::chrono::steady_clock;
     ++step_;
     const auto t0 = clock::now();
@@ -107,9 +126,7 @@ void Driver::check_health()
     variant_.snapshot(scratch_);
     const Scene& scene = *setup_.scene;
     const State& st = *setup_.state;
-    double rmin = st.radius.empty() ? 0.0 : *std::min_element(st.radius.begin(), st.radius.end());
-    const std::string hint = fmt::format("Δt = {:g} s; the Rayleigh time of the smallest particle is {:.3g} s, a step of at most "
-                                         "0.2 of it is usually stable", scene.dt, rayleigh_time(scene.material, rmin));
+    const std::string hint = stability_hint();
     auto finite = [](const Vec3d& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
     const std::size_t n = scratch_.position.size();
     for (std::size_t i = 0; i < n; ++i) {

@@ -1,7 +1,7 @@
 // The linked-list contact store: the design the DEMMAT paper rejected ("the linked list method based
 // on pointers and target variables", because a list rebuilt every step allocates and frees a node for
-// every contact every step). The particles' state is held exactly as in the arrays variant (flat
-// arrays, column by column); only the contact store differs, so a comparison with arrays isolates it.
+// every contact every step). The particles' state is the arrays variant's own (ColumnState, flat arrays
+// column by column); only the contact store differs, so a comparison with arrays isolates it.
 //
 // Particle i owns a singly linked list of nodes {partner j > i, next}, kept sorted by partner id, and a
 // second list of its wall contacts, sorted by wall index. Each step the search finds the current
@@ -27,6 +27,7 @@
 #include <memory>
 #include <vector>
 
+#include "../arrays/column_state.hpp"
 #include "demmat/linked_cells.hpp"
 #include "demmat/registry.hpp"
 
@@ -143,33 +144,6 @@ private:
     std::size_t& live_;
 };
 
-// ---- per-component helpers on the (N, 3) column layout (as in the arrays variant) -------------------
-
-template <class T>
-void gear_predictor(std::size_t n3, T* x, T* v, T* a, T* b3, T* b4, const T* b5, const GearCoefficients<T>& k)
-{
-    for (std::size_t e = 0; e < n3; ++e) gear_predict(x[e], v[e], a[e], b3[e], b4[e], b5[e], k);
-}
-
-template <class T>
-void gear_corrector(std::size_t n3, T* x, T* v, T* a, T* b3, T* b4, T* b5, const T* a_new, const GearCoefficients<T>& k)
-{
-    for (std::size_t e = 0; e < n3; ++e) {
-        const T da = a_new[e] - a[e];
-        gear_correct(x[e], v[e], a[e], b3[e], b4[e], b5[e], da, k);
-    }
-}
-
-template <class T>
-Vec3<T> get(const T* a, std::size_t n, std::size_t i) { return {a[i], a[n + i], a[2 * n + i]}; }
-template <class T>
-void add(T* a, std::size_t n, std::size_t i, const Vec3<T>& v)
-{
-    a[i] += v.x;
-    a[n + i] += v.y;
-    a[2 * n + i] += v.z;
-}
-
 // ---- the processor ---------------------------------------------------------------------------------
 
 // Rebuild: empty every list (release all nodes) at the start of each search, so the merge acquires a
@@ -185,61 +159,22 @@ public:
     void init(const Setup& setup) override
     {
         free_lists();
-        const State& s = *setup.state;
-        const Scene& scene = *setup.scene;
-        n_ = s.size();
-        step_ = s.step;
-        gear_ = GearCoefficients<T>::make(scene.dt);
-        params_ = setup.contact.template as<T>();
-        g_ = cast<T>(scene.gravity);
-        walls_ = s.walls;
-        dt_ = scene.dt;
+        state_.load(setup);
+        const std::size_t n = state_.size();
         cell_ = T(setup.cell_size);
-        for (auto* arr : {&x_, &v_, &a_, &b3_, &b4_, &b5_, &th_, &w_, &al_, &r3_, &r4_, &r5_, &f_, &t_, &acc_, &alc_})
-            arr->assign(3 * n_, T(0));
-        auto load = [this](std::vector<T>& dst, const std::vector<Vec3d>& src) {
-            for (std::size_t i = 0; i < n_; ++i)
-                for (int c = 0; c < 3; ++c) dst[c * n_ + i] = T(component(src[i], c));
-        };
-        load(x_, s.trans.x); load(v_, s.trans.v); load(a_, s.trans.a);
-        load(b3_, s.trans.b3); load(b4_, s.trans.b4); load(b5_, s.trans.b5);
-        load(th_, s.rot.x); load(w_, s.rot.v); load(al_, s.rot.a);
-        load(r3_, s.rot.b3); load(r4_, s.rot.b4); load(r5_, s.rot.b5);
-        r_.resize(n_); m_.resize(n_); I_.resize(n_);
-        for (std::size_t i = 0; i < n_; ++i) {
-            r_[i] = T(s.radius[i]);
-            m_[i] = T(setup.mass[i]);
-            I_[i] = T(setup.inertia[i]);
-        }
-        nw_ = walls_.size();
-        wp_.assign(3 * nw_, T(0)); wn_.assign(3 * nw_, T(0)); wv_.assign(3 * nw_, T(0));
-        for (std::size_t w = 0; w < nw_; ++w)
-            for (int c = 0; c < 3; ++c) {
-                wn_[3 * w + c] = T(component(walls_[w].normal, c));
-                wv_[3 * w + c] = T(component(walls_[w].velocity, c));
-            }
-        place_walls(step_);
-
-        pp_head_.assign(n_, nullptr);
-        pw_head_.assign(n_, nullptr);
+        pp_head_.assign(n, nullptr);
+        pw_head_.assign(n, nullptr);
         pp_live_ = pw_live_ = 0;
         // A dense bed keeps about three partners j > i per particle and a fraction of a wall contact;
         // the pool starts there and doubles if a scene needs more. (A no-op for the heap policy.)
-        nodes_.reserve(4 * n_ + 64);
+        nodes_.reserve(4 * n + 64);
         scratch_.clear();
         scratch_.reserve(64);
-        cells_.reserve(n_);
+        cells_.reserve(n);
         pp_ = pw_ = candidates_ = 0;
     }
 
-    void predict(std::int64_t step) override
-    {
-        step_ = step;
-        gear_predictor(3 * n_, x_.data(), v_.data(), a_.data(), b3_.data(), b4_.data(), b5_.data(), gear_);
-        if constexpr (M::rotation)
-            gear_predictor(3 * n_, th_.data(), w_.data(), al_.data(), r3_.data(), r4_.data(), r5_.data(), gear_);
-        place_walls(step);
-    }
+    void predict(std::int64_t step) override { state_.predict(step); }
 
     void search() override
     {
@@ -251,104 +186,33 @@ public:
 
     void forces() override
     {
-        std::fill(f_.begin(), f_.end(), T(0));
-        std::fill(t_.begin(), t_.end(), T(0));
+        state_.zero_loads();
         pp_ = 0;
         pw_ = 0;
         candidates_ = std::int64_t(pp_live_);
-        const std::size_t n = n_;
-        const T* x = x_.data();
-        const T* v = v_.data();
-        const T* w = w_.data();
+        const std::size_t n = state_.size();
         // Particles in id order, each list in partner order: the canonical order of physics.md §6.
-        for (std::size_t i = 0; i < n; ++i) {
-            for (const Node* node = pp_head_[i]; node != nullptr; node = node->next) {
-                const auto j = std::size_t(node->partner);
-                ContactForce<T> c;
-                if (!particle_contact<M>(get(x, n, i), get(x, n, j), get(v, n, i), get(v, n, j), get(w, n, i), get(w, n, j),
-                                         r_[i], r_[j], m_[i], m_[j], params_, c))
-                    continue;
-                ++pp_;
-                add(f_.data(), n, i, c.f_i);
-                add(f_.data(), n, j, -c.f_i);
-                if constexpr (M::rotation) {
-                    add(t_.data(), n, i, c.t_i);
-                    add(t_.data(), n, j, c.t_j);
-                }
-            }
-        }
-        for (std::size_t i = 0; i < n; ++i) {
-            for (const Node* node = pw_head_[i]; node != nullptr; node = node->next) {
-                const auto k = std::size_t(node->partner);
-                ContactForce<T> c;
-                if (!wall_contact<M>(get(x, n, i), get(v, n, i), get(w, n, i), r_[i], m_[i],
-                                     Vec3<T>{wp_[3 * k], wp_[3 * k + 1], wp_[3 * k + 2]},
-                                     Vec3<T>{wn_[3 * k], wn_[3 * k + 1], wn_[3 * k + 2]},
-                                     Vec3<T>{wv_[3 * k], wv_[3 * k + 1], wv_[3 * k + 2]}, params_, c))
-                    continue;
-                ++pw_;
-                add(f_.data(), n, i, c.f_i);
-                if constexpr (M::rotation) add(t_.data(), n, i, c.t_i);
-            }
-        }
-        const T g[3] = {g_.x, g_.y, g_.z};
-        for (int c = 0; c < 3; ++c)
-            for (std::size_t i = 0; i < n; ++i) {
-                acc_[c * n + i] = acceleration(f_[c * n + i], m_[i], g[c]);
-                if constexpr (M::rotation) alc_[c * n + i] = t_[c * n + i] / I_[i];
-            }
+        for (std::size_t i = 0; i < n; ++i)
+            for (const Node* node = pp_head_[i]; node != nullptr; node = node->next)
+                if (state_.pair(i, std::size_t(node->partner))) ++pp_;
+        for (std::size_t i = 0; i < n; ++i)
+            for (const Node* node = pw_head_[i]; node != nullptr; node = node->next)
+                if (state_.wall(i, std::size_t(node->partner))) ++pw_;
+        state_.newton();
     }
 
-    void correct() override
-    {
-        gear_corrector(3 * n_, x_.data(), v_.data(), a_.data(), b3_.data(), b4_.data(), b5_.data(), acc_.data(), gear_);
-        if constexpr (M::rotation)
-            gear_corrector(3 * n_, th_.data(), w_.data(), al_.data(), r3_.data(), r4_.data(), r5_.data(), alc_.data(), gear_);
-    }
-
-    void snapshot(Snapshot& out) const override
-    {
-        out.resize(n_);
-        out.step = step_;
-        for (std::size_t i = 0; i < n_; ++i) {
-            out.position[i] = cast<double>(get(x_.data(), n_, i));
-            out.velocity[i] = cast<double>(get(v_.data(), n_, i));
-            out.angular_velocity[i] = cast<double>(get(w_.data(), n_, i));
-            out.force[i] = cast<double>(get(f_.data(), n_, i));
-            out.torque[i] = cast<double>(get(t_.data(), n_, i));
-        }
-    }
-
-    void save(State& out) const override
-    {
-        out.resize(n_);
-        out.step = step_;
-        out.walls = walls_;
-        const std::vector<T>* src[12] = {&x_, &v_, &a_, &b3_, &b4_, &b5_, &th_, &w_, &al_, &r3_, &r4_, &r5_};
-        std::vector<Vec3d>* dst[12] = {&out.trans.x, &out.trans.v, &out.trans.a, &out.trans.b3, &out.trans.b4, &out.trans.b5,
-                                       &out.rot.x,   &out.rot.v,   &out.rot.a,   &out.rot.b3,   &out.rot.b4,   &out.rot.b5};
-        for (int k = 0; k < 12; ++k)
-            for (std::size_t i = 0; i < n_; ++i) (*dst[k])[i] = cast<double>(get(src[k]->data(), n_, i));
-        for (std::size_t i = 0; i < n_; ++i) out.radius[i] = double(r_[i]);
-    }
-
+    void correct() override { state_.correct(); }
+    void snapshot(Snapshot& out) const override { state_.snapshot(out); }
+    void save(State& out) const override { state_.save(out); }
     ContactCounts counts() const override { return {pp_, pw_, candidates_}; }
 
     std::size_t memory_bytes() const override
     {
-        return 19 * 3 * n_ * sizeof(T) + (pp_head_.size() + pw_head_.size()) * sizeof(Node*) + nodes_.bytes(pp_live_ + pw_live_) +
+        return state_.memory_bytes() + (pp_head_.size() + pw_head_.size()) * sizeof(Node*) + nodes_.bytes(pp_live_ + pw_live_) +
                scratch_.capacity() * sizeof(Index) + cells_.memory_bytes();
     }
 
 private:
-    void place_walls(std::int64_t step)
-    {
-        for (std::size_t w = 0; w < nw_; ++w) {
-            const Vec3d p = walls_[w].point_at(step, dt_);
-            for (int c = 0; c < 3; ++c) wp_[3 * w + c] = T(component(p, c));
-        }
-    }
-
     // Merges particle i's sorted candidates (in scratch_) into its list.
     void update_pairs(std::size_t i)
     {
@@ -360,13 +224,14 @@ private:
     // Every pair (the paper's "no cells"), O(N²); candidates come out ascending.
     void search_all_pairs()
     {
-        const std::size_t n = n_;
-        const T* x = x_.data();
+        const std::size_t n = state_.size();
+        const T* x = state_.x();
+        const T* r = state_.r();
         for (std::size_t i = 0; i < n; ++i) {
             ListMerge<Nodes> merge(pp_head_[i], nodes_, pp_live_);
             const Vec3<T> xi = get(x, n, i);
             for (std::size_t j = i + 1; j < n; ++j)
-                if (may_touch(xi, get(x, n, j), r_[i], r_[j])) merge.keep(Index(j));
+                if (may_touch(xi, get(x, n, j), r[i], r[j])) merge.keep(Index(j));
             merge.finish();
         }
     }
@@ -375,14 +240,15 @@ private:
     // scratch row, then merged into its list.
     void search_cells()
     {
-        const std::size_t n = n_;
-        const T* x = x_.data();
+        const std::size_t n = state_.size();
+        const T* x = state_.x();
+        const T* r = state_.r();
         cells_.build(n, x, x + n, x + 2 * n, cell_);
         for (std::size_t i = 0; i < n; ++i) {
             scratch_.clear();
             const Vec3<T> xi = get(x, n, i);
             cells_.for_each_above(i, [&](std::size_t j) {
-                if (!may_touch(xi, get(x, n, j), r_[i], r_[j])) return;
+                if (!may_touch(xi, get(x, n, j), r[i], r[j])) return;
                 scratch_.push_back(Index(j));
                 insert_ascending(scratch_.data(), std::int64_t(scratch_.size()) - 1, Index(j));
             });
@@ -393,15 +259,14 @@ private:
     // Per particle, the walls in wall order: they come out ascending and merge straight into the list.
     void search_walls()
     {
-        const std::size_t n = n_;
-        const T* x = x_.data();
+        const std::size_t n = state_.size(), nw = state_.wall_count();
+        const T* x = state_.x();
+        const T* r = state_.r();
         for (std::size_t i = 0; i < n; ++i) {
             ListMerge<Nodes> merge(pw_head_[i], nodes_, pw_live_);
             const Vec3<T> xi = get(x, n, i);
-            for (std::size_t w = 0; w < nw_; ++w) {
-                const Vec3<T> p{wp_[3 * w], wp_[3 * w + 1], wp_[3 * w + 2]}, nv{wn_[3 * w], wn_[3 * w + 1], wn_[3 * w + 2]};
-                if (may_touch_wall(xi, r_[i], p, nv)) merge.keep(Index(w));
-            }
+            for (std::size_t w = 0; w < nw; ++w)
+                if (may_touch_wall(xi, r[i], state_.wall_point(w), state_.wall_normal(w))) merge.keep(Index(w));
             merge.finish();
         }
     }
@@ -418,18 +283,8 @@ private:
         pp_live_ = pw_live_ = 0;
     }
 
-    std::size_t n_ = 0, nw_ = 0;
-    std::int64_t step_ = 0;
-    double dt_ = 0.0;
+    ColumnState<T, M> state_;
     T cell_ = T(0);
-    GearCoefficients<T> gear_;
-    ContactParams<T> params_;
-    Vec3<T> g_;
-    std::vector<Wall> walls_;
-    std::vector<T> x_, v_, a_, b3_, b4_, b5_, th_, w_, al_, r3_, r4_, r5_;  // (N, 3) each
-    std::vector<T> f_, t_, acc_, alc_;                                      // (N, 3) each
-    std::vector<T> r_, m_, I_;                                              // (N)
-    std::vector<T> wp_, wn_, wv_;                                           // (3, walls)
     // Declared before the list heads, so it outlives them on destruction (the destructor empties the
     // lists first in any case).
     Nodes nodes_;

@@ -1,5 +1,7 @@
 #include "neighbour_search.hpp"
 
+#include "demmat/linked_cells.hpp"
+
 #include <cmath>
 #include <iterator>
 
@@ -17,9 +19,11 @@ std::int64_t AllPairsSearch::update(std::vector<SphericalParticle>& particles)
     return pairs;
 }
 
-CellSearch::CellKey CellSearch::key_of(const Vec3d& x) const
+CellSearch::CellKey CellSearch::key_of(const SphericalParticle& p) const
 {
-    return {std::int64_t(std::floor(x.x / edge_)), std::int64_t(std::floor(x.y / edge_)), std::int64_t(std::floor(x.z / edge_))};
+    const Vec3d& x = p.position();
+    const auto id = std::size_t(p.id());
+    return {cell_coordinate(x.x / edge_, id), cell_coordinate(x.y / edge_, id), cell_coordinate(x.z / edge_, id)};
 }
 
 CellSearch::Cell& CellSearch::cell_at(const CellKey& key)
@@ -60,7 +64,7 @@ std::int64_t CellSearch::update(std::vector<SphericalParticle>& particles)
     for (auto& [key, cell] : cells_) cell.members.clear();
     std::size_t occupied = 0;
     for (SphericalParticle& p : particles) {
-        Cell& cell = cell_at(key_of(p.position()));
+        Cell& cell = cell_at(key_of(p));
         occupied += cell.members.empty();
         cell.members.push_back(&p);
         p.clear_neighbours();

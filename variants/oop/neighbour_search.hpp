@@ -54,7 +54,7 @@ private:
         std::vector<Cell*> adjacent;              // the existing cells among the 26 around this one
     };
 
-    CellKey key_of(const Vec3d& x) const;
+    CellKey key_of(const SphericalParticle& p) const;
     Cell& cell_at(const CellKey& key);  // finds the cell, or creates it and links it to its neighbours
     void drop_empty_cells();
 

@@ -4,6 +4,7 @@
 // outside the timed phases.
 #include <chrono>
 #include <cstdint>
+#include <string>
 
 #include "demmat/variant.hpp"
 
@@ -31,6 +32,9 @@ public:
     const Setup& setup() const { return setup_; }
 
 private:
+    void timed_step();
+    std::string stability_hint() const;
+
     Variant& variant_;
     const Setup& setup_;
     std::int64_t step_;

@@ -24,6 +24,18 @@
 
 namespace demmat {
 
+// floor(q) as an integer cell coordinate. A NaN, an infinity or a coordinate beyond 2^40 cells means the
+// run has blown up (the conversion would be undefined): stop with the particle; the driver adds the step.
+template <class T>
+inline std::int64_t cell_coordinate(T q, std::size_t particle)
+{
+    const T f = std::floor(q);
+    if (!(std::abs(f) < T(1099511627776.0)))
+        throw InstabilityError(fmt::format("particle {} has a non-finite or runaway position (found by the cell search)", particle),
+                               -1, std::int64_t(particle));
+    return std::int64_t(f);
+}
+
 class LinkedCells {
 public:
     using Index = std::int32_t;
@@ -50,7 +62,7 @@ public:
             const T lo = *std::min_element(xs[c], xs[c] + n);
             std::int64_t hi = 0;
             for (std::size_t i = 0; i < n; ++i) {
-                cs[c][i] = std::int64_t(std::floor((xs[c][i] - lo) / edge)) + 1;  // +1: an empty padding layer
+                cs[c][i] = cell_coordinate((xs[c][i] - lo) / edge, i) + 1;  // +1: an empty padding layer
                 hi = std::max(hi, cs[c][i]);
             }
             dims_[c] = hi + 2;
