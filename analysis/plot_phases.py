@@ -101,12 +101,38 @@ def markdown(stats, order, bench):
     return ("Median µs per step (ratio to arrays). " + caption(bench).replace("\n", ". ") + "\n\n" + "\n".join(lines) + "\n")
 
 
+def paper_ratios(stats, paper_json):
+    """The paper's Figure 7 ratios (its three codes) beside this run's, when f90, oop and pascal ran."""
+    have = set(stats.variant.astype(str))
+    if not {"f90", "oop"} <= have or not paper_json or not os.path.exists(paper_json):
+        return ""
+    with open(paper_json) as f:
+        paper = json.load(f)["figure7_ratios_stated"]
+    med = stats.assign(variant=stats.variant.astype(str), phase=stats.phase.astype(str)).set_index(["variant", "phase"])["median"]
+
+    def fmt(v):
+        return f"{v[0]:g}–{v[1]:g}" if isinstance(v, list) else f"{v:g}"
+
+    rows = [("OOP C++ / F90, whole step", "CPP_over_F90_whole_step", "oop", "total"),
+            ("OOP C++ / F90, predictor", "CPP_over_F90_predictor", "oop", "predict"),
+            ("OOP C++ / F90, corrector", "CPP_over_F90_corrector", "oop", "correct"),
+            ("OOP C++ / F90, search + forces", "CPP_over_F90_search_and_forces", "oop", "search_plus_forces"),
+            ("Object Pascal / F90, whole step", "PAS_over_F90_whole_step", "pascal", "total")]
+    lines = ["| ratio | paper (2005) | this run |", "|---|---|---|"]
+    for label, key, v, ph in rows:
+        if v in have:
+            lines.append(f"| {label} | {fmt(paper[key])} | {med[(v, ph)] / med[('f90', ph)]:.2f} |")
+    return "\n\nThe paper's three codes (its Figure 7) against today's compilers:\n\n" + "\n".join(lines) + "\n"
+
+
 def main(argv):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("bench", help="JSON written by `demmat bench --json`")
     ap.add_argument("--figure", required=True)
     ap.add_argument("--table", required=True)
     ap.add_argument("--markdown", help="also write the table as Markdown")
+    ap.add_argument("--paper", default=os.path.join(os.path.dirname(__file__), "..", "..", "shared", "data", "paper.json"),
+                    help="the paper's figures (default: ../shared/data/paper.json beside the project)")
     a = ap.parse_args(argv)
     with open(a.bench) as f:
         bench = json.load(f)
@@ -115,7 +141,7 @@ def main(argv):
     atomic_write(a.table, lambda tmp: stats.to_csv(tmp, index=False, float_format="%.6g"))
     figure(stats, order, bench, a.figure)
     if a.markdown:
-        text = markdown(stats, order, bench)
+        text = markdown(stats, order, bench) + paper_ratios(stats, a.paper)
         atomic_write(a.markdown, lambda tmp: open(tmp, "w").write(text))
     print(stats.to_string(index=False, float_format=lambda x: f"{x:.4g}"))
 
