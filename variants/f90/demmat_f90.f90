@@ -1,13 +1,16 @@
 ! DEMMAT_F90: the arrays processor (variants/arrays) in Fortran 90, driven from C++ through bind(C).
 !
 ! The particles' state is held in allocatable real(8) arrays of shape (N, 3) (rows = particles,
-! columns = components), passed as explicit-shape dummy arguments with intent attributes to
-! gear_predictor, gear_corrector and the contact routines. Capacities are fixed at init; an overflow is
-! reported to C++ as a status code (C++ throws CapacityError / InstabilityError with the messages of the
-! arrays variant). Every expression mirrors common/include/demmat/{gear,contact_law}.hpp operation for
-! operation; the parentheses spell out C++'s left-to-right evaluation (Fortran honours parentheses), so
-! the trajectories are bit-identical to the C++ variants (physics.md section 6). Constants (Gear
-! coefficients, contact parameters) are passed in from C++, never recomputed here.
+! columns = components), passed as explicit-shape dummy arguments with intent attributes to the
+! EXTERNAL procedures gear_predictor, gear_corrector, contact_force, pair_contact and wall_contact
+! (and their helpers dot, cross), defined after `end module` and declared by an INTERFACE block in
+! the module's specification part (the paper's style); they use no module data. Capacities are
+! fixed at init; an overflow is reported to C++ as a status code (C++ throws CapacityError /
+! InstabilityError with the messages of the arrays variant). Every expression mirrors
+! common/include/demmat/{gear,contact_law}.hpp operation for operation; the parentheses spell
+! out C++'s left-to-right evaluation (Fortran honours parentheses), so the trajectories are
+! bit-identical to the C++ variants (physics.md section 6). Constants (Gear coefficients, contact
+! parameters) are passed in from C++, never recomputed here.
 !
 ! Search: linked cells (head/next) over the particles' bounding box, padded by one empty cell layer,
 ! as a direct grid of dims(1)*dims(2)*dims(3) cells. When that grid would exceed 8*N + 4096 cells (a
@@ -47,137 +50,72 @@ module demmat_f90
     integer(i8) :: pp = 0, pw = 0, cand = 0
   end type processor
 
+  ! The compute kernels are EXTERNAL procedures (defined after `end module`); this interface block gives
+  ! every caller in the module their exact explicit interfaces.
+  interface
+    subroutine gear_predictor(n, x, v, a, b3, b4, b5, dt, half_dt2, two_over_dt2)
+      use, intrinsic :: iso_c_binding
+      implicit none
+      integer, parameter :: dp = c_double
+      integer, intent(in) :: n
+      real(dp), intent(inout) :: x(n, 3), v(n, 3), a(n, 3), b3(n, 3), b4(n, 3)
+      real(dp), intent(in) :: b5(n, 3)
+      real(dp), intent(in) :: dt, half_dt2, two_over_dt2
+    end subroutine gear_predictor
+    subroutine gear_corrector(n, x, v, a, b3, b4, b5, a_new, cx, cv, c3, c4, c5)
+      use, intrinsic :: iso_c_binding
+      implicit none
+      integer, parameter :: dp = c_double
+      integer, intent(in) :: n
+      real(dp), intent(inout) :: x(n, 3), v(n, 3), a(n, 3), b3(n, 3), b4(n, 3), b5(n, 3)
+      real(dp), intent(in) :: a_new(n, 3)
+      real(dp), intent(in) :: cx, cv, c3, c4, c5
+    end subroutine gear_corrector
+    pure function cross(a, b) result(c)
+      use, intrinsic :: iso_c_binding
+      implicit none
+      integer, parameter :: dp = c_double
+      real(dp), intent(in) :: a(3), b(3)
+      real(dp) :: c(3)
+    end function cross
+    pure function dot(a, b) result(s)
+      use, intrinsic :: iso_c_binding
+      implicit none
+      integer, parameter :: dp = c_double
+      real(dp), intent(in) :: a(3), b(3)
+      real(dp) :: s
+    end function dot
+    subroutine contact_force(n, h, u, rstar, mstar, hertz, gamma_n, gamma_t, mu, f_i, f_t)
+      use, intrinsic :: iso_c_binding
+      implicit none
+      integer, parameter :: dp = c_double
+      real(dp), intent(in) :: n(3), h, u(3), rstar, mstar, hertz, gamma_n, gamma_t, mu
+      real(dp), intent(out) :: f_i(3), f_t(3)
+    end subroutine contact_force
+    logical function pair_contact(nn, i, j, x, v, w, r, m, f, t, hertz, gamma_n, gamma_t, mu)
+      use, intrinsic :: iso_c_binding
+      implicit none
+      integer, parameter :: dp = c_double
+      integer, intent(in) :: nn, i, j
+      real(dp), intent(in) :: x(nn, 3), v(nn, 3), w(nn, 3), r(nn), m(nn)
+      real(dp), intent(inout) :: f(nn, 3), t(nn, 3)
+      real(dp), intent(in) :: hertz, gamma_n, gamma_t, mu
+    end function pair_contact
+    logical function wall_contact(nn, i, x, v, w, r, m, f, t, point, normal, vw, hertz, gamma_n, gamma_t, mu)
+      use, intrinsic :: iso_c_binding
+      implicit none
+      integer, parameter :: dp = c_double
+      integer, intent(in) :: nn, i
+      real(dp), intent(in) :: x(nn, 3), v(nn, 3), w(nn, 3), r(nn), m(nn)
+      real(dp), intent(inout) :: f(nn, 3), t(nn, 3)
+      real(dp), intent(in) :: point(3), normal(3), vw(3), hertz, gamma_n, gamma_t, mu
+    end function wall_contact
+  end interface
+
   public :: f90_create, f90_destroy, f90_init, f90_predict, f90_search, f90_forces, f90_correct
   public :: f90_get, f90_counts
 
 contains
-
-  ! ---- Gear --------------------------------------------------------------------------------------
-
-  subroutine gear_predictor(n, x, v, a, b3, b4, b5, dt, half_dt2, two_over_dt2)
-    integer, intent(in) :: n
-    real(dp), intent(inout) :: x(n, 3), v(n, 3), a(n, 3), b3(n, 3), b4(n, 3)
-    real(dp), intent(in) :: b5(n, 3)
-    real(dp), intent(in) :: dt, half_dt2, two_over_dt2
-    integer :: i, c
-    do c = 1, 3
-      do i = 1, n
-        x(i, c) = ((((x(i, c) + dt*v(i, c)) + half_dt2*a(i, c)) + b3(i, c)) + b4(i, c)) + b5(i, c)
-        v(i, c) = (v(i, c) + dt*a(i, c)) + (((3.0_dp*b3(i, c)) + (4.0_dp*b4(i, c))) + (5.0_dp*b5(i, c)))/dt
-        a(i, c) = a(i, c) + two_over_dt2*(((3.0_dp*b3(i, c)) + (6.0_dp*b4(i, c))) + (10.0_dp*b5(i, c)))
-        b3(i, c) = (b3(i, c) + 4.0_dp*b4(i, c)) + 10.0_dp*b5(i, c)
-        b4(i, c) = b4(i, c) + 5.0_dp*b5(i, c)
-      end do
-    end do
-  end subroutine gear_predictor
-
-  subroutine gear_corrector(n, x, v, a, b3, b4, b5, a_new, cx, cv, c3, c4, c5)
-    integer, intent(in) :: n
-    real(dp), intent(inout) :: x(n, 3), v(n, 3), a(n, 3), b3(n, 3), b4(n, 3), b5(n, 3)
-    real(dp), intent(in) :: a_new(n, 3)
-    real(dp), intent(in) :: cx, cv, c3, c4, c5
-    integer :: i, c
-    real(dp) :: da
-    do c = 1, 3
-      do i = 1, n
-        da = a_new(i, c) - a(i, c)
-        x(i, c) = x(i, c) + cx*da
-        v(i, c) = v(i, c) + cv*da
-        a(i, c) = a(i, c) + da
-        b3(i, c) = b3(i, c) + c3*da
-        b4(i, c) = b4(i, c) + c4*da
-        b5(i, c) = b5(i, c) + c5*da
-      end do
-    end do
-  end subroutine gear_corrector
-
-  ! ---- contact law (contact_law.hpp) -------------------------------------------------------------
-
-  pure function cross(a, b) result(c)
-    real(dp), intent(in) :: a(3), b(3)
-    real(dp) :: c(3)
-    c(1) = a(2)*b(3) - a(3)*b(2)
-    c(2) = a(3)*b(1) - a(1)*b(3)
-    c(3) = a(1)*b(2) - a(2)*b(1)
-  end function cross
-
-  pure function dot(a, b) result(s)
-    real(dp), intent(in) :: a(3), b(3)
-    real(dp) :: s
-    s = (a(1)*b(1) + a(2)*b(2)) + a(3)*b(3)
-  end function dot
-
-  ! detail::contact_force
-  subroutine contact_force(n, h, u, rstar, mstar, hertz, gamma_n, gamma_t, mu, f_i, f_t)
-    real(dp), intent(in) :: n(3), h, u(3), rstar, mstar, hertz, gamma_n, gamma_t, mu
-    real(dp), intent(out) :: f_i(3), f_t(3)
-    real(dp) :: fn, un, ut(3), ut_abs, ft, a1, a2
-    fn = ((hertz*sqrt(rstar))*h)*sqrt(h)
-    un = dot(u, n)
-    fn = fn + (gamma_n*mstar)*un
-    if (fn < 0.0_dp) fn = 0.0_dp
-    f_t = 0.0_dp
-    ut = u - un*n
-    ut_abs = sqrt(dot(ut, ut))
-    if (ut_abs > 0.0_dp) then
-      a1 = mu*fn
-      a2 = (gamma_t*mstar)*ut_abs
-      ft = a1                    ! std::min(a1, a2): a2 < a1 ? a2 : a1
-      if (a2 < a1) ft = a2
-      f_t = (-ft)*(ut/ut_abs)
-    end if
-    f_i = (-fn)*n + f_t
-  end subroutine contact_force
-
-  ! particle_contact, i < j; adds the forces and torques to f and t (N, 3). Returns .false. when h <= 0.
-  logical function pair_contact(nn, i, j, x, v, w, r, m, f, t, hertz, gamma_n, gamma_t, mu)
-    integer, intent(in) :: nn, i, j
-    real(dp), intent(in) :: x(nn, 3), v(nn, 3), w(nn, 3), r(nn), m(nn)
-    real(dp), intent(inout) :: f(nn, 3), t(nn, 3)
-    real(dp), intent(in) :: hertz, gamma_n, gamma_t, mu
-    real(dp) :: dx(3), d, h, n(3), rstar, mstar, di(3), dj(3), u(3), f_i(3), f_t(3), ri, rj, mi, mj
-    dx = x(j, :) - x(i, :)
-    d = sqrt(dot(dx, dx))
-    ri = r(i); rj = r(j); mi = m(i); mj = m(j)
-    h = (ri + rj) - d
-    pair_contact = .false.
-    if (.not. (h > 0.0_dp)) return
-    pair_contact = .true.
-    n = dx/d
-    rstar = (ri*rj)/(ri + rj)
-    mstar = (mi*mj)/(mi + mj)
-    di = (ri - h*0.5_dp)*n
-    dj = -((rj - h*0.5_dp)*n)
-    u = v(i, :) - v(j, :)
-    u = (u + cross(w(i, :), di)) - cross(w(j, :), dj)
-    call contact_force(n, h, u, rstar, mstar, hertz, gamma_n, gamma_t, mu, f_i, f_t)
-    f(i, :) = f(i, :) + f_i
-    f(j, :) = f(j, :) + (-f_i)
-    t(i, :) = t(i, :) + cross(di, f_t)
-    t(j, :) = t(j, :) + cross(dj, -f_t)
-  end function pair_contact
-
-  ! wall_contact; adds to particle i. Returns .false. when h <= 0.
-  logical function wall_contact(nn, i, x, v, w, r, m, f, t, point, normal, vw, hertz, gamma_n, gamma_t, mu)
-    integer, intent(in) :: nn, i
-    real(dp), intent(in) :: x(nn, 3), v(nn, 3), w(nn, 3), r(nn), m(nn)
-    real(dp), intent(inout) :: f(nn, 3), t(nn, 3)
-    real(dp), intent(in) :: point(3), normal(3), vw(3), hertz, gamma_n, gamma_t, mu
-    real(dp) :: s, h, n(3), di(3), u(3), f_i(3), f_t(3), ri
-    ri = r(i)
-    s = dot(x(i, :) - point, normal)
-    h = ri - s
-    wall_contact = .false.
-    if (.not. (h > 0.0_dp)) return
-    wall_contact = .true.
-    n = -normal
-    di = (ri - h*0.5_dp)*n
-    u = v(i, :) - vw
-    u = u + cross(w(i, :), di)
-    call contact_force(n, h, u, ri, m(i), hertz, gamma_n, gamma_t, mu, f_i, f_t)
-    f(i, :) = f(i, :) + f_i
-    t(i, :) = t(i, :) + cross(di, f_t)
-  end function wall_contact
 
   ! ---- search ------------------------------------------------------------------------------------
 
@@ -521,3 +459,208 @@ contains
   end subroutine f90_counts
 
 end module demmat_f90
+
+! ==== external compute kernels (explicit interfaces: the interface block in module demmat_f90) ====
+
+! ---- Gear --------------------------------------------------------------------------------------
+
+subroutine gear_predictor(n, x, v, a, b3, b4, b5, dt, half_dt2, two_over_dt2)
+  use, intrinsic :: iso_c_binding
+  implicit none
+  integer, parameter :: dp = c_double
+  integer, intent(in) :: n
+  real(dp), intent(inout) :: x(n, 3), v(n, 3), a(n, 3), b3(n, 3), b4(n, 3)
+  real(dp), intent(in) :: b5(n, 3)
+  real(dp), intent(in) :: dt, half_dt2, two_over_dt2
+  integer :: i, c
+  do c = 1, 3
+    do i = 1, n
+      x(i, c) = ((((x(i, c) + dt*v(i, c)) + half_dt2*a(i, c)) + b3(i, c)) + b4(i, c)) + b5(i, c)
+      v(i, c) = (v(i, c) + dt*a(i, c)) + (((3.0_dp*b3(i, c)) + (4.0_dp*b4(i, c))) + (5.0_dp*b5(i, c)))/dt
+      a(i, c) = a(i, c) + two_over_dt2*(((3.0_dp*b3(i, c)) + (6.0_dp*b4(i, c))) + (10.0_dp*b5(i, c)))
+      b3(i, c) = (b3(i, c) + 4.0_dp*b4(i, c)) + 10.0_dp*b5(i, c)
+      b4(i, c) = b4(i, c) + 5.0_dp*b5(i, c)
+    end do
+  end do
+end subroutine gear_predictor
+
+subroutine gear_corrector(n, x, v, a, b3, b4, b5, a_new, cx, cv, c3, c4, c5)
+  use, intrinsic :: iso_c_binding
+  implicit none
+  integer, parameter :: dp = c_double
+  integer, intent(in) :: n
+  real(dp), intent(inout) :: x(n, 3), v(n, 3), a(n, 3), b3(n, 3), b4(n, 3), b5(n, 3)
+  real(dp), intent(in) :: a_new(n, 3)
+  real(dp), intent(in) :: cx, cv, c3, c4, c5
+  integer :: i, c
+  real(dp) :: da
+  do c = 1, 3
+    do i = 1, n
+      da = a_new(i, c) - a(i, c)
+      x(i, c) = x(i, c) + cx*da
+      v(i, c) = v(i, c) + cv*da
+      a(i, c) = a(i, c) + da
+      b3(i, c) = b3(i, c) + c3*da
+      b4(i, c) = b4(i, c) + c4*da
+      b5(i, c) = b5(i, c) + c5*da
+    end do
+  end do
+end subroutine gear_corrector
+
+! ---- contact law (contact_law.hpp) -------------------------------------------------------------
+
+pure function cross(a, b) result(c)
+  use, intrinsic :: iso_c_binding
+  implicit none
+  integer, parameter :: dp = c_double
+  real(dp), intent(in) :: a(3), b(3)
+  real(dp) :: c(3)
+  c(1) = a(2)*b(3) - a(3)*b(2)
+  c(2) = a(3)*b(1) - a(1)*b(3)
+  c(3) = a(1)*b(2) - a(2)*b(1)
+end function cross
+
+pure function dot(a, b) result(s)
+  use, intrinsic :: iso_c_binding
+  implicit none
+  integer, parameter :: dp = c_double
+  real(dp), intent(in) :: a(3), b(3)
+  real(dp) :: s
+  s = (a(1)*b(1) + a(2)*b(2)) + a(3)*b(3)
+end function dot
+
+! detail::contact_force
+subroutine contact_force(n, h, u, rstar, mstar, hertz, gamma_n, gamma_t, mu, f_i, f_t)
+  use, intrinsic :: iso_c_binding
+  implicit none
+  integer, parameter :: dp = c_double
+  interface
+    pure function dot(a, b) result(s)
+      use, intrinsic :: iso_c_binding
+      implicit none
+      integer, parameter :: dp = c_double
+      real(dp), intent(in) :: a(3), b(3)
+      real(dp) :: s
+    end function dot
+  end interface
+  real(dp), intent(in) :: n(3), h, u(3), rstar, mstar, hertz, gamma_n, gamma_t, mu
+  real(dp), intent(out) :: f_i(3), f_t(3)
+  real(dp) :: fn, un, ut(3), ut_abs, ft, a1, a2
+  fn = ((hertz*sqrt(rstar))*h)*sqrt(h)
+  un = dot(u, n)
+  fn = fn + (gamma_n*mstar)*un
+  if (fn < 0.0_dp) fn = 0.0_dp
+  f_t = 0.0_dp
+  ut = u - un*n
+  ut_abs = sqrt(dot(ut, ut))
+  if (ut_abs > 0.0_dp) then
+    a1 = mu*fn
+    a2 = (gamma_t*mstar)*ut_abs
+    ft = a1                    ! std::min(a1, a2): a2 < a1 ? a2 : a1
+    if (a2 < a1) ft = a2
+    f_t = (-ft)*(ut/ut_abs)
+  end if
+  f_i = (-fn)*n + f_t
+end subroutine contact_force
+
+! particle_contact, i < j; adds the forces and torques to f and t (N, 3). Returns .false. when h <= 0.
+logical function pair_contact(nn, i, j, x, v, w, r, m, f, t, hertz, gamma_n, gamma_t, mu)
+  use, intrinsic :: iso_c_binding
+  implicit none
+  integer, parameter :: dp = c_double
+  interface
+    pure function cross(a, b) result(c)
+      use, intrinsic :: iso_c_binding
+      implicit none
+      integer, parameter :: dp = c_double
+      real(dp), intent(in) :: a(3), b(3)
+      real(dp) :: c(3)
+    end function cross
+    pure function dot(a, b) result(s)
+      use, intrinsic :: iso_c_binding
+      implicit none
+      integer, parameter :: dp = c_double
+      real(dp), intent(in) :: a(3), b(3)
+      real(dp) :: s
+    end function dot
+    subroutine contact_force(n, h, u, rstar, mstar, hertz, gamma_n, gamma_t, mu, f_i, f_t)
+      use, intrinsic :: iso_c_binding
+      implicit none
+      integer, parameter :: dp = c_double
+      real(dp), intent(in) :: n(3), h, u(3), rstar, mstar, hertz, gamma_n, gamma_t, mu
+      real(dp), intent(out) :: f_i(3), f_t(3)
+    end subroutine contact_force
+  end interface
+  integer, intent(in) :: nn, i, j
+  real(dp), intent(in) :: x(nn, 3), v(nn, 3), w(nn, 3), r(nn), m(nn)
+  real(dp), intent(inout) :: f(nn, 3), t(nn, 3)
+  real(dp), intent(in) :: hertz, gamma_n, gamma_t, mu
+  real(dp) :: dx(3), d, h, n(3), rstar, mstar, di(3), dj(3), u(3), f_i(3), f_t(3), ri, rj, mi, mj
+  dx = x(j, :) - x(i, :)
+  d = sqrt(dot(dx, dx))
+  ri = r(i); rj = r(j); mi = m(i); mj = m(j)
+  h = (ri + rj) - d
+  pair_contact = .false.
+  if (.not. (h > 0.0_dp)) return
+  pair_contact = .true.
+  n = dx/d
+  rstar = (ri*rj)/(ri + rj)
+  mstar = (mi*mj)/(mi + mj)
+  di = (ri - h*0.5_dp)*n
+  dj = -((rj - h*0.5_dp)*n)
+  u = v(i, :) - v(j, :)
+  u = (u + cross(w(i, :), di)) - cross(w(j, :), dj)
+  call contact_force(n, h, u, rstar, mstar, hertz, gamma_n, gamma_t, mu, f_i, f_t)
+  f(i, :) = f(i, :) + f_i
+  f(j, :) = f(j, :) + (-f_i)
+  t(i, :) = t(i, :) + cross(di, f_t)
+  t(j, :) = t(j, :) + cross(dj, -f_t)
+end function pair_contact
+
+! wall_contact; adds to particle i. Returns .false. when h <= 0.
+logical function wall_contact(nn, i, x, v, w, r, m, f, t, point, normal, vw, hertz, gamma_n, gamma_t, mu)
+  use, intrinsic :: iso_c_binding
+  implicit none
+  integer, parameter :: dp = c_double
+  interface
+    pure function cross(a, b) result(c)
+      use, intrinsic :: iso_c_binding
+      implicit none
+      integer, parameter :: dp = c_double
+      real(dp), intent(in) :: a(3), b(3)
+      real(dp) :: c(3)
+    end function cross
+    pure function dot(a, b) result(s)
+      use, intrinsic :: iso_c_binding
+      implicit none
+      integer, parameter :: dp = c_double
+      real(dp), intent(in) :: a(3), b(3)
+      real(dp) :: s
+    end function dot
+    subroutine contact_force(n, h, u, rstar, mstar, hertz, gamma_n, gamma_t, mu, f_i, f_t)
+      use, intrinsic :: iso_c_binding
+      implicit none
+      integer, parameter :: dp = c_double
+      real(dp), intent(in) :: n(3), h, u(3), rstar, mstar, hertz, gamma_n, gamma_t, mu
+      real(dp), intent(out) :: f_i(3), f_t(3)
+    end subroutine contact_force
+  end interface
+  integer, intent(in) :: nn, i
+  real(dp), intent(in) :: x(nn, 3), v(nn, 3), w(nn, 3), r(nn), m(nn)
+  real(dp), intent(inout) :: f(nn, 3), t(nn, 3)
+  real(dp), intent(in) :: point(3), normal(3), vw(3), hertz, gamma_n, gamma_t, mu
+  real(dp) :: s, h, n(3), di(3), u(3), f_i(3), f_t(3), ri
+  ri = r(i)
+  s = dot(x(i, :) - point, normal)
+  h = ri - s
+  wall_contact = .false.
+  if (.not. (h > 0.0_dp)) return
+  wall_contact = .true.
+  n = -normal
+  di = (ri - h*0.5_dp)*n
+  u = v(i, :) - vw
+  u = u + cross(w(i, :), di)
+  call contact_force(n, h, u, ri, m(i), hertz, gamma_n, gamma_t, mu, f_i, f_t)
+  f(i, :) = f(i, :) + f_i
+  t(i, :) = t(i, :) + cross(di, f_t)
+end function wall_contact
