@@ -3,8 +3,8 @@
 ! The particles' state is held in allocatable real(8) arrays of shape (N, 3) (rows = particles,
 ! columns = components), passed as explicit-shape dummy arguments with intent attributes to the
 ! EXTERNAL procedures gear_predictor, gear_corrector, contact_force, pair_contact and wall_contact
-! (and their helpers dot, cross), defined after `end module` and declared by an INTERFACE block in
-! the module's specification part (the paper's style); they use no module data. Capacities are
+! (and their helpers dot, cross), defined after `end module demmat_f90` and declared once by the
+! INTERFACE block of module demmat_f90_kernels (the paper's style); they use no module data. Capacities are
 ! fixed at init; an overflow is reported to C++ as a status code (C++ throws CapacityError /
 ! InstabilityError with the messages of the arrays variant). Every expression mirrors
 ! common/include/demmat/{gear,contact_law}.hpp operation for operation; the parentheses spell
@@ -16,42 +16,11 @@
 ! as a direct grid of dims(1)*dims(2)*dims(3) cells. When that grid would exceed 8*N + 4096 cells (a
 ! huge, sparse box) the search falls back to the all-pairs loop; the candidate set is the same either
 ! way (may_touch decides). cell_size == 0 means all pairs.
-module demmat_f90
-  use, intrinsic :: iso_c_binding
+
+! Explicit interfaces of the external compute kernels (defined after module demmat_f90), written once
+! and used by the module and by the kernels that call each other.
+module demmat_f90_kernels
   implicit none
-  private
-
-  integer, parameter :: dp = c_double
-  integer, parameter :: i8 = c_int64_t
-
-  ! status codes returned to C++
-  integer(c_int), parameter :: ST_OK = 0, ST_PAIR_CAP = 1, ST_WALL_CAP = 2, ST_RUNAWAY = 3
-
-  type :: processor
-    integer :: n = 0, nw = 0, cap = 0, wcap = 0
-    real(dp) :: cell = 0.0_dp
-    ! Gear coefficients and contact parameters (from C++)
-    real(dp) :: dt, half_dt2, two_over_dt2, cx, cv, c3, c4, c5
-    real(dp) :: hertz_pp, hertz_pw, gamma_n, gamma_t, mu
-    real(dp) :: g(3)
-    ! state, (N, 3) each
-    real(dp), allocatable :: x(:,:), v(:,:), a(:,:), b3(:,:), b4(:,:), b5(:,:)
-    real(dp), allocatable :: th(:,:), w(:,:), al(:,:), r3(:,:), r4(:,:), r5(:,:)
-    real(dp), allocatable :: f(:,:), t(:,:), acc(:,:), alc(:,:)
-    real(dp), allocatable :: r(:), m(:), inert(:)
-    ! walls, (3, nw)
-    real(dp), allocatable :: wp(:,:), wn(:,:), wv(:,:)
-    ! contact store
-    integer, allocatable :: ncount(:), partner(:,:)   ! (N), (cap, N)
-    integer, allocatable :: wcount(:), wall(:,:)      ! (N), (wcap, N)
-    ! linked cells
-    integer, allocatable :: head(:), next(:)
-    integer(i8), allocatable :: cellidx(:), cc3(:,:)
-    integer(i8) :: pp = 0, pw = 0, cand = 0
-  end type processor
-
-  ! The compute kernels are EXTERNAL procedures (defined after `end module`); this interface block gives
-  ! every caller in the module their exact explicit interfaces.
   interface
     subroutine gear_predictor(n, x, v, a, b3, b4, b5, dt, half_dt2, two_over_dt2)
       use, intrinsic :: iso_c_binding
@@ -111,6 +80,43 @@ module demmat_f90
       real(dp), intent(in) :: point(3), normal(3), vw(3), hertz, gamma_n, gamma_t, mu
     end function wall_contact
   end interface
+end module demmat_f90_kernels
+
+module demmat_f90
+  use, intrinsic :: iso_c_binding
+  use demmat_f90_kernels  ! the external compute kernels' interfaces (defined after `end module`)
+  implicit none
+  private
+
+  integer, parameter :: dp = c_double
+  integer, parameter :: i8 = c_int64_t
+
+  ! status codes returned to C++
+  integer(c_int), parameter :: ST_OK = 0, ST_PAIR_CAP = 1, ST_WALL_CAP = 2, ST_RUNAWAY = 3
+
+  type :: processor
+    integer :: n = 0, nw = 0, cap = 0, wcap = 0
+    real(dp) :: cell = 0.0_dp
+    ! Gear coefficients and contact parameters (from C++)
+    real(dp) :: dt, half_dt2, two_over_dt2, cx, cv, c3, c4, c5
+    real(dp) :: hertz_pp, hertz_pw, gamma_n, gamma_t, mu
+    real(dp) :: g(3)
+    ! state, (N, 3) each
+    real(dp), allocatable :: x(:,:), v(:,:), a(:,:), b3(:,:), b4(:,:), b5(:,:)
+    real(dp), allocatable :: th(:,:), w(:,:), al(:,:), r3(:,:), r4(:,:), r5(:,:)
+    real(dp), allocatable :: f(:,:), t(:,:), acc(:,:), alc(:,:)
+    real(dp), allocatable :: r(:), m(:), inert(:)
+    ! walls, (3, nw)
+    real(dp), allocatable :: wp(:,:), wn(:,:), wv(:,:)
+    ! contact store
+    integer, allocatable :: ncount(:), partner(:,:)   ! (N), (cap, N)
+    integer, allocatable :: wcount(:), wall(:,:)      ! (N), (wcap, N)
+    ! linked cells
+    integer, allocatable :: head(:), next(:)
+    integer(i8), allocatable :: cellidx(:), cc3(:,:)
+    integer(i8) :: pp = 0, pw = 0, cand = 0
+  end type processor
+
 
   public :: f90_create, f90_destroy, f90_init, f90_predict, f90_search, f90_forces, f90_correct
   public :: f90_get, f90_counts
@@ -532,17 +538,9 @@ end function dot
 ! detail::contact_force
 subroutine contact_force(n, h, u, rstar, mstar, hertz, gamma_n, gamma_t, mu, f_i, f_t)
   use, intrinsic :: iso_c_binding
+  use demmat_f90_kernels, only: dot
   implicit none
   integer, parameter :: dp = c_double
-  interface
-    pure function dot(a, b) result(s)
-      use, intrinsic :: iso_c_binding
-      implicit none
-      integer, parameter :: dp = c_double
-      real(dp), intent(in) :: a(3), b(3)
-      real(dp) :: s
-    end function dot
-  end interface
   real(dp), intent(in) :: n(3), h, u(3), rstar, mstar, hertz, gamma_n, gamma_t, mu
   real(dp), intent(out) :: f_i(3), f_t(3)
   real(dp) :: fn, un, ut(3), ut_abs, ft, a1, a2
@@ -566,31 +564,9 @@ end subroutine contact_force
 ! particle_contact, i < j; adds the forces and torques to f and t (N, 3). Returns .false. when h <= 0.
 logical function pair_contact(nn, i, j, x, v, w, r, m, f, t, hertz, gamma_n, gamma_t, mu)
   use, intrinsic :: iso_c_binding
+  use demmat_f90_kernels, only: cross, dot, contact_force
   implicit none
   integer, parameter :: dp = c_double
-  interface
-    pure function cross(a, b) result(c)
-      use, intrinsic :: iso_c_binding
-      implicit none
-      integer, parameter :: dp = c_double
-      real(dp), intent(in) :: a(3), b(3)
-      real(dp) :: c(3)
-    end function cross
-    pure function dot(a, b) result(s)
-      use, intrinsic :: iso_c_binding
-      implicit none
-      integer, parameter :: dp = c_double
-      real(dp), intent(in) :: a(3), b(3)
-      real(dp) :: s
-    end function dot
-    subroutine contact_force(n, h, u, rstar, mstar, hertz, gamma_n, gamma_t, mu, f_i, f_t)
-      use, intrinsic :: iso_c_binding
-      implicit none
-      integer, parameter :: dp = c_double
-      real(dp), intent(in) :: n(3), h, u(3), rstar, mstar, hertz, gamma_n, gamma_t, mu
-      real(dp), intent(out) :: f_i(3), f_t(3)
-    end subroutine contact_force
-  end interface
   integer, intent(in) :: nn, i, j
   real(dp), intent(in) :: x(nn, 3), v(nn, 3), w(nn, 3), r(nn), m(nn)
   real(dp), intent(inout) :: f(nn, 3), t(nn, 3)
@@ -620,31 +596,9 @@ end function pair_contact
 ! wall_contact; adds to particle i. Returns .false. when h <= 0.
 logical function wall_contact(nn, i, x, v, w, r, m, f, t, point, normal, vw, hertz, gamma_n, gamma_t, mu)
   use, intrinsic :: iso_c_binding
+  use demmat_f90_kernels, only: cross, dot, contact_force
   implicit none
   integer, parameter :: dp = c_double
-  interface
-    pure function cross(a, b) result(c)
-      use, intrinsic :: iso_c_binding
-      implicit none
-      integer, parameter :: dp = c_double
-      real(dp), intent(in) :: a(3), b(3)
-      real(dp) :: c(3)
-    end function cross
-    pure function dot(a, b) result(s)
-      use, intrinsic :: iso_c_binding
-      implicit none
-      integer, parameter :: dp = c_double
-      real(dp), intent(in) :: a(3), b(3)
-      real(dp) :: s
-    end function dot
-    subroutine contact_force(n, h, u, rstar, mstar, hertz, gamma_n, gamma_t, mu, f_i, f_t)
-      use, intrinsic :: iso_c_binding
-      implicit none
-      integer, parameter :: dp = c_double
-      real(dp), intent(in) :: n(3), h, u(3), rstar, mstar, hertz, gamma_n, gamma_t, mu
-      real(dp), intent(out) :: f_i(3), f_t(3)
-    end subroutine contact_force
-  end interface
   integer, intent(in) :: nn, i
   real(dp), intent(in) :: x(nn, 3), v(nn, 3), w(nn, 3), r(nn), m(nn)
   real(dp), intent(inout) :: f(nn, 3), t(nn, 3)
