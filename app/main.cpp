@@ -126,10 +126,7 @@ int cmd_run(const RunArgs& a)
     const auto start = clock::now();
     auto last = start;
     const bool tty = isatty(STDERR_FILENO);
-    const int interval = l->scene.checks.interval;
-    for (std::int64_t k = 1; k <= steps; ++k) {
-        driver.step();
-        if (interval > 0 && (k % interval == 0 || k == steps)) driver.check_health();
+    driver.run(steps, [&](std::int64_t k) {
         if (vtk && a.vtk_every > 0 && (k % a.vtk_every == 0 || k == steps)) write_vtk();
         if (!a.quiet && (k & 63) == 0) {
             const auto now = clock::now();
@@ -141,7 +138,7 @@ int cmd_run(const RunArgs& a)
                                          el / double(k) * double(steps - k), tty ? "   " : "\n");
             }
         }
-    }
+    });
     const double wall = std::chrono::duration<double>(clock::now() - start).count();
     if (!a.quiet && tty) std::cerr << "\r" << std::string(78, ' ') << "\r";
 

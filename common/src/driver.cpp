@@ -112,12 +112,13 @@ void Driver::timed_step()
     ++steps_taken_;
 }
 
-void Driver::run(std::int64_t steps)
+void Driver::run(std::int64_t steps, const std::function<void(std::int64_t)>& after_step)
 {
     const int interval = setup_.scene->checks.interval;
-    for (std::int64_t k = 0; k < steps; ++k) {
+    for (std::int64_t k = 1; k <= steps; ++k) {
         step();
-        if (interval > 0 && (steps_taken_ % interval == 0 || k + 1 == steps)) check_health();
+        if (interval > 0 && (steps_taken_ % interval == 0 || k == steps)) check_health();
+        if (after_step) after_step(k);
     }
 }
 

@@ -4,6 +4,7 @@
 // outside the timed phases.
 #include <chrono>
 #include <cstdint>
+#include <functional>
 #include <string>
 
 #include "demmat/variant.hpp"
@@ -21,7 +22,9 @@ public:
     Driver(Variant& variant, const Setup& setup);
 
     void step();                     // one timed step
-    void run(std::int64_t steps);    // `steps` timed steps, with health checks at the scene's interval
+    // `steps` timed steps, with health checks at the scene's interval; after_step(k), k = 1 … steps, runs
+    // after each step, outside the timed phases (snapshots, progress).
+    void run(std::int64_t steps, const std::function<void(std::int64_t)>& after_step = {});
     void check_health();             // throws InstabilityError naming the step and particle
 
     std::int64_t current_step() const { return step_; }
