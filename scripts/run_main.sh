@@ -2,16 +2,19 @@
 # The main job: installs what is missing, builds, writes the standard scenes, settles the dense bed
 # once (kept in states/), checks that every registered variant is bit-identical on the compression
 # stage, benchmarks every variant per phase, and writes results/ (JSON, CSV, figure).
-# Usage: scripts/run_main.sh [--n N] [--steps K] [--repetitions R]
+# Then it draws the figures of scripts/run_figures.sh (Figure 4, cell-size sweep, scaling, where the
+# time goes): the short sweep by default, the full one with --full (an hour or more).
+# Usage: scripts/run_main.sh [--n N] [--steps K] [--repetitions R] [--full]
 set -euo pipefail
 cd "$(dirname "$0")/.."
-n=2000; steps=500; reps=5
+n=2000; steps=500; reps=5; sweep=()
 while [[ $# -gt 0 ]]; do
   case "$1" in
+    --full) sweep=(--full); shift ;;
     --n) n="$2"; shift 2 ;;
     --steps) steps="$2"; shift 2 ;;
     --repetitions) reps="$2"; shift 2 ;;
-    *) echo "run_main.sh: unknown option $1 (expected --n, --steps, --repetitions)" >&2; exit 2 ;;
+    *) echo "run_main.sh: unknown option $1 (expected --n, --steps, --repetitions, --full)" >&2; exit 2 ;;
   esac
 done
 
@@ -50,3 +53,6 @@ echo "== analysis"
 /usr/bin/python3 analysis/plot_phases.py "$json" --figure results/figures/phases_compression_${n}.png \
   --table results/main/phases_compression_${n}.csv --markdown results/main/phases_compression_${n}.md
 echo "results: $json, results/main/phases_compression_${n}.csv, results/figures/phases_compression_${n}.png"
+
+echo "== figures: Figure 4, cell-size sweep, scaling, where the time goes"
+scripts/run_figures.sh "${sweep[@]}"

@@ -16,6 +16,8 @@ struct VariantInfo {
     std::string name;
     std::string summary;  // one line for `demmat list`
     std::function<std::unique_ptr<Variant>()> create;
+    bool bitwise = true;    // bit-identical to arrays at every step (false: drops the canonical order on purpose)
+    bool threaded = false;  // uses set_threads() threads (demmat/threads.hpp); benchmarks also time it at 1
 };
 
 class Registry {
