@@ -15,10 +15,13 @@
 #include "demmat/checker.hpp"
 #include "demmat/driver.hpp"
 #include "demmat/error.hpp"
+#include "demmat/features.hpp"
 #include "demmat/io.hpp"
 #include "demmat/output.hpp"
 #include "demmat/registry.hpp"
 #include "demmat/scenes.hpp"
+#include "demmat/threads.hpp"
+#include "peer_commands.hpp"
 
 namespace fs = std::filesystem;
 using json = nlohmann::json;
@@ -48,6 +51,10 @@ std::unique_ptr<Loaded> load(const std::string& file, bool allow_unstable)
 
 std::int64_t steps_for(const Scene& scene, std::int64_t steps, double time)
 {
+    // 2^53 steps: beyond that a step count is not exact in a double (and the conversion could overflow).
+    if (!(time >= 0.0) || !(time / scene.dt < 9007199254740992.0))
+        throw Error(fmt::format("--time {} is not a time >= 0 s that a run of Δt = {:g} s can reach", time, scene.dt));
+    if (steps < 0) throw Error(fmt::format("--steps {} is negative", steps));
     if (time > 0.0) return std::int64_t(std::ceil(time / scene.dt - 1e-9));  // integer steps, never accumulated time
     return steps;
 }
@@ -89,12 +96,15 @@ json scene_json(const Loaded& l)
             {"start_step", l.state.step},
             {"search", s.search.method == SearchMethod::cells ? "cells" : "all_pairs"},
             {"cell_size_rmax", s.search.method == SearchMethod::cells ? s.search.cell_size : 0.0},
-            {"cell_size_m", l.setup.cell_size}};
+            {"cell_size_m", l.setup.cell_size},
+            {"integrator", name(s.integrator.scheme)},
+            {"precision", name(s.integrator.precision)}};
 }
 
 // ---- demmat run ------------------------------------------------------------------------------------
 struct RunArgs {
     std::string scene, variant = "arrays", json_file, save_file, vtk_dir;
+    std::string integrator, precision;  // override the scene's [integrator] when given
     std::int64_t steps = 1000, vtk_every = 0;
     double time = 0.0;
     bool quiet = false, allow_unstable = false;
@@ -103,6 +113,16 @@ struct RunArgs {
 int cmd_run(const RunArgs& a)
 {
     auto l = load(a.scene, a.allow_unstable);
+    if (!a.integrator.empty()) {
+        const auto s = parse_integrator(a.integrator);
+        if (!s) throw Error(fmt::format("unknown integrator '{}' (expected {})", a.integrator, integrator_names));
+        l->scene.integrator.scheme = *s;
+    }
+    if (!a.precision.empty()) {
+        const auto p = parse_precision(a.precision);
+        if (!p) throw Error(fmt::format("unknown precision '{}' (expected {})", a.precision, precision_names));
+        l->scene.integrator.precision = *p;
+    }
     const VariantInfo& info = registry().find(a.variant);
     const std::int64_t steps = steps_for(l->scene, a.steps, a.time);
     auto variant = info.create();
@@ -150,6 +170,10 @@ int cmd_run(const RunArgs& a)
     const double per = 1.0 / double(std::max<std::int64_t>(1, steps));
     std::cout << fmt::format("variant {}  scene {}  particles {}  steps {}  t = {:.6g} s\n", info.name, l->scene.name,
                              l->state.size(), steps, driver.time());
+    std::cout << fmt::format("integrator {}\n", l->scene.integrator.describe());
+    // The model instantiation the variant picked in init() (docs/design.md, "Model features").
+    std::cout << fmt::format("model {}  (the scene needs {})\n", variant->model().name(),
+                             features_of(l->scene, l->state).name());
     std::cout << fmt::format("steps per second {:.1f}  ({:.4f} us per particle-step)\n", double(steps) / t.total(),
                              t.total() * per / n * 1e6);
     std::cout << fmt::format("per step: predict {:.3e} s  search {:.3e} s  forces {:.3e} s  correct {:.3e} s  total {:.3e} s\n",
@@ -171,7 +195,9 @@ int cmd_run(const RunArgs& a)
         json j = {{"provenance", provenance_json()},
                   {"scene", scene_json(*l)},
                   {"variant", info.name},
+                  {"model", {{"picked", variant->model().name()}, {"scene_needs", features_of(l->scene, l->state).name()}}},
                   {"steps", steps},
+                  {"threads", max_threads()},
                   {"end_time", driver.time()},
                   {"wall_seconds", wall},
                   {"steps_per_second", double(steps) / t.total()},
@@ -192,6 +218,8 @@ int cmd_compare(const std::string& scene, const std::string& variants, std::int6
     auto l = load(scene, allow_unstable);
     // A variant may be named twice: two instances must agree too (run-to-run determinism).
     auto names = variant_list(variants, true);
+    if (variants == "all")  // every variant that promises bit identity (fast_unordered drops it on purpose)
+        std::erase_if(names, [](const std::string& n) { return !registry().find(n).bitwise; });
     if (variants == "all" && names.size() == 1) names.push_back(names.front());
     if (names.size() < 2) throw Error("compare needs at least two variants (a variant may be named twice)");
     const std::int64_t k = steps_for(l->scene, steps, time);
@@ -228,6 +256,7 @@ int cmd_bench(const BenchArgs& a)
     std::map<std::string, std::map<std::string, std::vector<double>>> samples;
     std::map<std::string, ContactCounts> counts;
     std::map<std::string, std::size_t> memory;
+    std::map<std::string, std::string> model;  // the model instantiation each variant picked
     json reps = json::array();
     for (std::int64_t r = 0; r < a.repetitions; ++r) {
         // Interleaved, with the order rotated each repetition, so drift of a shared machine hits all alike.
@@ -248,6 +277,7 @@ int cmd_bench(const BenchArgs& a)
             }
             counts[name] = variant->counts();
             memory[name] = variant->memory_bytes();
+            model[name] = variant->model().name();
         }
         std::cerr << fmt::format("demmat bench: repetition {}/{} done\n", r + 1, a.repetitions);
     }
@@ -273,19 +303,22 @@ int cmd_bench(const BenchArgs& a)
                            {"seconds_per_step", ph},
                            {"us_per_particle_step", tot_med / n * 1e6},
                            {"contacts_per_particle", (2.0 * double(c.particle_particle) + double(c.particle_wall)) / n},
-                           {"memory_bytes", memory[name]}});
+                           {"memory_bytes", memory[name]},
+                           {"model", model[name]}});
         std::cout << fmt::format("{:<16} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e} {:>10.4f}\n", name,
                                  ph["predict"]["median"].get<double>(), ph["search"]["median"].get<double>(),
                                  ph["forces"]["median"].get<double>(), ph["correct"]["median"].get<double>(), tot_med,
                                  tot_med / n * 1e6);
     }
-    std::cout << "(seconds per step, medians over " << a.repetitions << " interleaved repetitions of " << a.steps << " steps)\n";
+    std::cout << "(seconds per step, medians over " << a.repetitions << " interleaved repetitions of " << a.steps << " steps; "
+              << max_threads() << " thread(s) for the threaded variants)\n";
     if (!a.json_file.empty()) {
         json j = {{"provenance", provenance_json()},
                   {"scene", scene_json(*l)},
                   {"steps", a.steps},
                   {"warmup_steps", a.warmup},
                   {"repetitions", a.repetitions},
+                  {"threads", max_threads()},
                   {"summary", summary},
                   {"samples", reps}};
         write_atomically(a.json_file, j.dump(2) + "\n");
@@ -336,6 +369,7 @@ int main(int argc, char** argv)
     app.set_help_all_flag("--help-all", "Help for every subcommand");
 
     auto* list = app.add_subcommand("list", "List the registered variants, one per line, name first");
+    PeerCommands peers(app);  // export-lammps, import-lammps, dump (docs/peers.md)
 
     SceneArgs sa;
     auto* scene = app.add_subcommand("scene", "Write a standard scene as an editable TOML file (to stdout without --out)");
@@ -360,6 +394,12 @@ int main(int argc, char** argv)
     run->add_option("--vtk-every", ra.vtk_every, "Steps between VTK snapshots (0: first and last only)");
     run->add_flag("--quiet,-q", ra.quiet, "No progress on stderr");
     run->add_flag("--allow-unstable", ra.allow_unstable, "Run even with a time step above the Rayleigh time, without warning");
+    run->add_option("--integrator", ra.integrator, "gear5 | gear3 | verlet | symplectic_euler (overrides the scene's [integrator])");
+    run->add_option("--precision", ra.precision, "double | float (overrides the scene's [integrator])");
+    // Threads of the OpenMP variants (fast, fast_unordered); 0 = OpenMP's default (OMP_NUM_THREADS, else all cores).
+    int threads = 0;
+    const char* threads_help = "Threads for the threaded variants (fast, fast_unordered); 0: OpenMP's default";
+    run->add_option("--threads", threads, threads_help)->check(CLI::NonNegativeNumber);
 
     std::string cmp_scene, cmp_variants = "all";
     std::int64_t cmp_steps = 100;
@@ -371,6 +411,7 @@ int main(int argc, char** argv)
     auto* cmp_steps_opt = compare->add_option("--steps,-n", cmp_steps, "Number of steps");
     compare->add_option("--time,-t", cmp_time, "Simulated time (s), instead of --steps")->excludes(cmp_steps_opt);
     compare->add_flag("--allow-unstable", cmp_allow, "Run even with a time step above the Rayleigh time, without warning");
+    compare->add_option("--threads", threads, threads_help)->check(CLI::NonNegativeNumber);
 
     BenchArgs ba;
     auto* bench = app.add_subcommand("bench", "Time variants per phase: interleaved repetitions, medians and spread");
@@ -381,7 +422,9 @@ int main(int argc, char** argv)
     bench->add_option("--warmup", ba.warmup, "Untimed steps before each repetition")->check(CLI::NonNegativeNumber);
     bench->add_option("--json", ba.json_file, "Write the samples and medians as JSON with provenance");
     bench->add_flag("--allow-unstable", ba.allow_unstable, "Run even with a time step above the Rayleigh time, without warning");
+    bench->add_option("--threads", threads, threads_help)->check(CLI::NonNegativeNumber);
 
+    remove_partial_files_on_signal();
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -392,6 +435,7 @@ int main(int argc, char** argv)
         std::cerr << "demmat: error: " << e.what() << " (see demmat --help)\n";
         return 2;
     }
+    set_threads(threads);
 
     try {
         if (*list) {
@@ -404,11 +448,15 @@ int main(int argc, char** argv)
         if (*run) return cmd_run(ra);
         if (*compare) return cmd_compare(cmp_scene, cmp_variants, cmp_steps, cmp_time, cmp_allow);
         if (*bench) return cmd_bench(ba);
+        if (const int rc = peers.dispatch(); rc >= 0) return rc;
     } catch (const InstabilityError& e) {
         std::cerr << "demmat: run stopped: " << e.what() << "\n";
         return 3;
     } catch (const Error& e) {
         std::cerr << "demmat: error: " << e.what() << "\n";
+        return 2;
+    } catch (const std::bad_alloc&) {
+        std::cerr << "demmat: error: out of memory (the scene needs more than this machine can allocate)\n";
         return 2;
     } catch (const std::exception& e) {
         std::cerr << "demmat: internal error: " << e.what() << "\n";

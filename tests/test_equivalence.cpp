@@ -14,41 +14,6 @@ using namespace demmat::test;
 
 namespace {
 
-// The dense bed of 2000 particles after 12000 steps (0.12 s) of settling from its loose grid: it has
-// collapsed into a contact-rich bed (about 3.5 contacts per particle, rising to 4.4 over the next
-// 5000 steps). Computed once with the arrays variant and cached beside the tests (each ctest is its
-// own process); any valid state serves, so a cache from older code is harmless.
-const std::int64_t kSettleSteps = 12000;
-State settling_bed_state(const Scene& bed)
-{
-    const std::filesystem::path cache = "equivalence_bed_2000_12000.state";
-    try {
-        State st = load_state(cache);
-        if (st.fingerprint == bed.fingerprint(st.size()) && st.step == kSettleSteps) return st;
-    } catch (const Error&) {
-    }
-    Case c(bed);
-    VariantRun run("arrays", c.setup);
-    run.driver->run(kSettleSteps);
-    State st;
-    run.variant->save(st);
-    st.dt = bed.dt;
-    st.fingerprint = c.state.fingerprint;
-    save_state(st, cache);
-    return st;
-}
-
-// The settling bed as a scene that starts from the cached state; with `wall_speed` > 0, the paper's
-// compression stage (the x_max wall moving inwards), re-anchored at the state's step.
-Case bed_case(double wall_speed)
-{
-    const Scene bed = dense_bed_scene(2000);
-    State st = settling_bed_state(bed);
-    Scene s = wall_speed > 0 ? compression_scene(bed, "(cached state)", wall_speed) : bed;
-    st.walls = continue_walls(s, st);
-    return Case(s, st);
-}
-
 std::string compare(const std::vector<std::string>& names, const Setup& setup, std::int64_t steps)
 {
     const CompareReport r = compare_variants(names, setup, steps);
@@ -61,6 +26,8 @@ class Equivalence : public ::testing::TestWithParam<std::string> {};
 
 TEST_P(Equivalence, SearchMethodsGiveBitIdenticalTrajectories)
 {
+    // Without the canonical order the sums follow the storage order, which the cell size changes.
+    if (!registry().find(GetParam()).bitwise) GTEST_SKIP() << "drops the canonical order on purpose (its physics is tested elsewhere)";
     // Cells of 2·R_max, 4·R_max and every pair: one trajectory, over thousands of contact-rich steps.
     const std::int64_t steps = 3000;
     std::vector<Snapshot> finals;
@@ -83,6 +50,7 @@ TEST_P(Equivalence, SearchMethodsGiveBitIdenticalTrajectories)
 TEST_P(Equivalence, DenseBedIsBitIdenticalToArraysAtEveryStep)
 {
     if (GetParam() == "arrays") GTEST_SKIP() << "the reference itself";
+    if (!registry().find(GetParam()).bitwise) GTEST_SKIP() << "drops the canonical order on purpose (its physics is tested elsewhere)";
     Case c = bed_case(0.0);
     EXPECT_EQ(compare({"arrays", GetParam()}, c.setup, 5000), "");
 }
@@ -90,6 +58,7 @@ TEST_P(Equivalence, DenseBedIsBitIdenticalToArraysAtEveryStep)
 TEST_P(Equivalence, CompressionStageIsBitIdenticalToArraysAtEveryStep)
 {
     if (GetParam() == "arrays") GTEST_SKIP() << "the reference itself";
+    if (!registry().find(GetParam()).bitwise) GTEST_SKIP() << "drops the canonical order on purpose (its physics is tested elsewhere)";
     Case c = bed_case(0.5);
     EXPECT_EQ(compare({"arrays", GetParam()}, c.setup, 3000), "");
 }
@@ -97,6 +66,7 @@ TEST_P(Equivalence, CompressionStageIsBitIdenticalToArraysAtEveryStep)
 TEST_P(Equivalence, PaperSceneIsBitIdenticalToArrays)
 {
     if (GetParam() == "arrays") GTEST_SKIP() << "the reference itself";
+    if (!registry().find(GetParam()).bitwise) GTEST_SKIP() << "drops the canonical order on purpose (its physics is tested elsewhere)";
     Case c(paper_scene());
     EXPECT_EQ(compare({"arrays", GetParam()}, c.setup, 300), "");
 }

@@ -1,6 +1,9 @@
 // The contact search against brute force: on random polydisperse packings (overlaps allowed), one
 // step with every variant and search setting must give forces bit-identical to the reference, which
 // takes every pair (O(N²)) and sums in the canonical order; the contact counts must match too.
+#include <algorithm>
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 #include "demmat/reference.hpp"
@@ -55,6 +58,20 @@ Case packing(const Packing& p, std::int64_t n, std::uint64_t seed)
     return Case(s, st);
 }
 
+double max_abs(const std::vector<Vec3d>& a)
+{
+    double m = 0.0;
+    for (const Vec3d& v : a) m = std::max({m, std::abs(v.x), std::abs(v.y), std::abs(v.z)});
+    return m;
+}
+
+double max_gap(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b)
+{
+    double m = 0.0;
+    for (std::size_t i = 0; i < a.size(); ++i) m = std::max({m, std::abs(a[i].x - b[i].x), std::abs(a[i].y - b[i].y), std::abs(a[i].z - b[i].z)});
+    return m;
+}
+
 } // namespace
 
 class Search : public ::testing::TestWithParam<std::tuple<std::string, int>> {};
@@ -88,6 +105,14 @@ TEST_P(Search, FindsExactlyTheBruteForceContactSet)
         Snapshot ref = s;
         ref.force = f;
         ref.torque = t;
+        if (!registry().find(variant).bitwise) {
+            // A variant that drops the canonical order sums the same contacts in another order. A
+            // reordered sum of k terms moves by about k·ε·Σ|terms| (k ≤ 64 here); 1e-10 of the largest
+            // force is far above that and far below a missed or extra contact (its own size).
+            EXPECT_LT(max_gap(ref.force, s.force), 1e-10 * max_abs(ref.force)) << p.name << " seed " << seed;
+            EXPECT_LT(max_gap(ref.torque, s.torque), 1e-10 * max_abs(ref.torque)) << p.name << " seed " << seed;
+            continue;
+        }
         const auto d = first_difference(ref, s);
         EXPECT_FALSE(d) << p.name << " seed " << seed << ": " << d->describe();
     }

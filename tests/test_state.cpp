@@ -1,5 +1,6 @@
 // Save and continue: a run continued from a saved state is bit-identical to one that never stopped,
 // also with a moving wall; the state file round-trips exactly and rejects damaged or foreign files.
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -53,8 +54,19 @@ TEST_P(SaveContinue, ContinuedRunIsBitIdenticalToUninterruptedRun)
         EXPECT_EQ(cont.state.step, 400);
         VariantRun second(GetParam(), cont.setup);
         second.driver->run(400);
-        const auto d = first_difference(whole.snapshot(), second.snapshot());
-        EXPECT_FALSE(d) << (moving ? "moving wall: " : "") << d->describe();
+        if (registry().find(GetParam()).bitwise) {
+            const auto d = first_difference(whole.snapshot(), second.snapshot());
+            EXPECT_FALSE(d) << (moving ? "moving wall: " : "") << d->describe();
+        } else {
+            // Without the canonical order the sums depend on the storage order, which a restart changes
+            // (the list is rebuilt at init): the runs part in the last bits. Over 400 steps that stays
+            // far below 1e-9 m (positions are ~1e-2 m, grains 3–5 mm); a lost state would be mm off.
+            const Snapshot a = whole.snapshot(), b = second.snapshot();
+            for (std::size_t i = 0; i < a.position.size(); ++i) {
+                const Vec3d g = a.position[i] - b.position[i];
+                ASSERT_LT(std::sqrt(dot(g, g)), 1e-9) << "particle " << i << (moving ? ", moving wall" : "");
+            }
+        }
         EXPECT_EQ(second.driver->current_step(), 800);
     }
     fs::remove_all(dir);

@@ -8,6 +8,7 @@
 #include "demmat/error.hpp"
 #include "demmat/reference.hpp"
 #include "demmat/registry.hpp"
+#include "demmat/stability.hpp"
 
 namespace demmat {
 
@@ -57,6 +58,11 @@ double kinetic_energy(const Snapshot& s, const Setup& setup)
 
 Driver::Driver(Variant& variant, const Setup& setup) : variant_(variant), setup_(setup), step_(setup.state->step)
 {
+    // The one place that refuses an integrator or precision a variant would otherwise silently ignore.
+    const IntegratorChoice& choice = setup.scene->integrator;
+    if (!variant_.supports(choice))
+        throw Error(fmt::format("this variant integrates with gear5 in double only, not {} (the arrays variant runs "
+                                "every integrator and precision)", choice.describe()));
     variant_.init(setup_);
     const Scene& scene = *setup.scene;
     if (scene.checks.max_speed > 0.0) {
@@ -70,6 +76,20 @@ Driver::Driver(Variant& variant, const Setup& setup) : variant_(variant), setup_
         const Vec3d ext = scene.domain.max - scene.domain.min;
         const double fall = std::sqrt(2.0 * std::sqrt(dot(scene.gravity, scene.gravity)) * std::sqrt(dot(ext, ext)));
         speed_bound_ = 10.0 * (v0 + fall + vw) + 1.0;
+    }
+    // Energy-growth check (docs/stability.md): the start energy and what gravity may add to it.
+    const State& st = *setup.state;
+    energy_check_ = std::none_of(st.walls.begin(), st.walls.end(), [](const Wall& w) { return w.moving(); });
+    if (energy_check_) {
+        x0_ = st.trans.x;
+        double ke = 0.0, mass = 0.0;
+        for (std::size_t i = 0; i < st.size(); ++i) {
+            ke += 0.5 * setup.mass[i] * dot(st.trans.v[i], st.trans.v[i]) + 0.5 * setup.inertia[i] * dot(st.rot.v[i], st.rot.v[i]);
+            mass += setup.mass[i];
+        }
+        energy0_ = ke + elastic_energy(st.trans.x, st.radius, st.walls, st.step, scene.dt, setup.contact);
+        // A floor for scenes that start at rest without gravity: a millionth of the grains' energy at 0.1 m/s.
+        energy_floor_ = 1e-6 * 0.5 * mass * 0.01;
     }
 }
 
@@ -88,8 +108,14 @@ std::string Driver::stability_hint() const
 {
     const State& st = *setup_.state;
     const double rmin = st.radius.empty() ? 0.0 : *std::min_element(st.radius.begin(), st.radius.end());
+    const ContactTime ct = shortest_contact_time(*setup_.scene, st, impact_speed_bound(*setup_.scene, st));
+    std::string hertz;
+    if (ct.tc > 0.0)
+        hertz = fmt::format(", the Hertz contact time at the largest impact speed {:.3g} m/s is {:.3g} s and {} is stable up to "
+                            "{} of it (docs/stability.md)", ct.speed, ct.tc, name(setup_.scene->integrator.scheme),
+                            stable_fraction_of_contact_time(setup_.scene->integrator.scheme));
     return fmt::format("Δt = {:g} s; the Rayleigh time of the smallest particle is {:.3g} s, a step of at most 0.2 of it is "
-                       "usually stable", setup_.scene->dt, rayleigh_time(setup_.scene->material, rmin));
+                       "usually stable{}", setup_.scene->dt, rayleigh_time(setup_.scene->material, rmin), hertz);
 }
 
 void Driver::timed_step()
@@ -130,14 +156,18 @@ void Driver::check_health()
     const std::string hint = stability_hint();
     auto finite = [](const Vec3d& v) { return std::isfinite(v.x) && std::isfinite(v.y) && std::isfinite(v.z); };
     const std::size_t n = scratch_.position.size();
+    // A derived bound also allows free fall since the start: a grain that left the domain through a side
+    // without a wall falls on (docs/stability.md); the energy check below bounds real growth tightly.
+    const double bound = scene.checks.max_speed > 0.0 ? speed_bound_
+        : speed_bound_ + 10.0 * std::sqrt(dot(scene.gravity, scene.gravity)) * double(step_ - st.step) * scene.dt;
     for (std::size_t i = 0; i < n; ++i) {
         if (!finite(scratch_.position[i]) || !finite(scratch_.velocity[i]) || !finite(scratch_.angular_velocity[i]))
             throw InstabilityError(fmt::format("step {}: particle {} has a non-finite position or velocity (NaN or Inf): "
                                                "the run is unstable ({})", step_, i, hint), step_, std::int64_t(i));
         const double speed = std::sqrt(dot(scratch_.velocity[i], scratch_.velocity[i]));
-        if (speed > speed_bound_)
+        if (speed > bound)
             throw InstabilityError(fmt::format("step {}: particle {} moves at {:.3g} m/s, above the bound {:.3g} m/s "
-                                               "(energy runaway; {})", step_, i, speed, speed_bound_, hint), step_, std::int64_t(i));
+                                               "(energy runaway; {})", step_, i, speed, bound, hint), step_, std::int64_t(i));
     }
     const double ratio = scene.checks.max_overlap_ratio;
     for (const Wall& w : st.walls) {
@@ -153,13 +183,32 @@ void Driver::check_health()
                                        step_, std::int64_t(i));
         }
     }
-    for (const auto& [i, j] : contact_pairs(scratch_.position, st.radius, false)) {
+    const auto pairs = contact_pairs(scratch_.position, st.radius, false);
+    for (const auto& [i, j] : pairs) {
         const Vec3d d = scratch_.position[j] - scratch_.position[i];
         const double h = st.radius[i] + st.radius[j] - std::sqrt(dot(d, d));
         const double r = std::min(st.radius[i], st.radius[j]);
         if (h > ratio * r)
             throw InstabilityError(fmt::format("step {}: particles {} and {} overlap by {:.3g} of the smaller radius, above "
                                                "the bound {} ({})", step_, i, j, h / r, ratio, hint), step_, i);
+    }
+    if (energy_check_) {
+        // Kinetic + elastic energy against the start energy plus the work gravity has done since.
+        double work = 0.0, worst = -1.0;
+        std::int64_t who = 0;
+        for (std::size_t i = 0; i < n; ++i) {
+            work += setup_.mass[i] * dot(scene.gravity, scratch_.position[i] - x0_[i]);
+            const double ke = 0.5 * setup_.mass[i] * dot(scratch_.velocity[i], scratch_.velocity[i]);
+            if (ke > worst) { worst = ke; who = std::int64_t(i); }
+        }
+        const double e = kinetic_energy(scratch_, setup_) +
+                         elastic_energy(scratch_.position, st.radius, st.walls, step_, scene.dt, setup_.contact);
+        const double supply = energy0_ + work;
+        const double bound = supply + kEnergyGrowthTolerance * (energy0_ + std::abs(work)) + energy_floor_;
+        if (!(e <= bound))
+            throw InstabilityError(fmt::format("step {}: kinetic + elastic energy {:.4g} J exceeds the start energy plus the work of "
+                                               "gravity, {:.4g} J, by more than {:g} % (energy growth; particle {} holds the most kinetic energy; {})",
+                                               step_, e, supply, 100.0 * kEnergyGrowthTolerance, who, hint), step_, who);
     }
 }
 

@@ -9,6 +9,7 @@
 #include "demmat/error.hpp"
 #include "demmat/io.hpp"
 #include "demmat/reference.hpp"
+#include "demmat/stability.hpp"
 
 namespace demmat {
 
@@ -218,13 +219,18 @@ State load_state(const std::filesystem::path& file)
     std::ifstream in(file, std::ios::binary);
     if (!in) throw Error(fmt::format("{}: cannot open state file: {}", label, std::strerror(errno)));
     const std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    return parse_state(bytes, label);
+}
+
+State parse_state(const std::string& bytes, const std::string& label)
+{
     if (bytes.size() < 8 || std::memcmp(bytes.data(), kMagic, 8) != 0)
         throw Error(fmt::format("{}: not a DEMMAT state file (bad magic)", label));
     Reader r(bytes, label);
     r.get<std::uint64_t>();  // magic
     const auto version = r.get<std::uint32_t>();
     if (version != kVersion) r.fail(fmt::format("state file version {} is not supported (expected {})", version, kVersion));
-    r.get<std::uint32_t>();
+    if (r.get<std::uint32_t>() != 0) r.fail("corrupt (the reserved header field is not zero)");
     State s;
     s.fingerprint = r.get<std::uint64_t>();
     s.step = r.get<std::int64_t>();
@@ -232,16 +238,24 @@ State load_state(const std::filesystem::path& file)
     const auto n = r.get<std::uint64_t>();
     const auto nw = r.get<std::uint64_t>();
     if (s.step < 0) r.fail("corrupt (negative step)");
+    if (!(s.dt > 0.0) || !std::isfinite(s.dt)) r.fail(fmt::format("corrupt (time step {})", s.dt));
     if (nw > 1024) r.fail("corrupt (too many walls)");
     // 37 doubles per particle: radius and twelve vectors.
     if (n == 0 || n > r.left() / (37 * sizeof(double))) r.fail(fmt::format("state file is truncated or corrupt ({} particles announced)", n));
     for (std::uint64_t k = 0; k < nw; ++k) {
         Wall w;
         w.name = r.str();
+        for (unsigned char c : w.name)  // names appear in one-line messages and in scene files
+            if (c < 0x20 || c == 0x7F) r.fail("corrupt (a wall name holds control characters)");
         w.point = r.vec();
         w.normal = r.vec();
         w.velocity = r.vec();
         w.ref_step = r.get<std::int64_t>();
+        for (const Vec3d& v : {w.point, w.normal, w.velocity})
+            if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+                r.fail(fmt::format("corrupt (wall '{}' has a non-finite point, normal or velocity)", w.name));
+        if (!(std::abs(dot(w.normal, w.normal) - 1.0) < 1e-9))
+            r.fail(fmt::format("corrupt (wall '{}' has a normal that is not a unit vector)", w.name));
         s.walls.push_back(w);
     }
     s.resize(std::size_t(n));
@@ -310,9 +324,12 @@ std::string check_time_step(const Scene& scene, const State& state)
     if (scene.dt > tr)
         throw Error(fmt::format("{}: time step {:g} s exceeds the Rayleigh time {:.3g} s of the smallest particle (R = {:g} m): "
                                 "the run would be unstable; use dt <= {:.3g} s", scene.name, scene.dt, tr, rmin, 0.2 * tr));
+    // The Hertz contact time at the scene's largest impact speed (stability.hpp, docs/stability.md): refused
+    // above the integrator's measured stability limit, a warning above kWarnFractionOfContactTime of it.
+    const std::string hertz = check_contact_time_step(scene, state);
     if (scene.dt > 0.2 * tr)
-        return fmt::format("time step {:g} s is {:.2f} of the Rayleigh time {:.3g} s; above 0.2 of it a run may be inaccurate or unstable",
-                           scene.dt, scene.dt / tr, tr);
-    return {};
+        return fmt::format("time step {:g} s is {:.2f} of the Rayleigh time {:.3g} s; above 0.2 of it a run may be inaccurate or unstable{}{}",
+                           scene.dt, scene.dt / tr, tr, hertz.empty() ? "" : "; ", hertz);
+    return hertz;
 }
 } // namespace demmat

@@ -11,6 +11,7 @@
 
 #include "column_state.hpp"
 #include "demmat/error.hpp"
+#include "demmat/features.hpp"
 #include "demmat/linked_cells.hpp"
 #include "demmat/registry.hpp"
 
@@ -78,8 +79,8 @@ void search_cells(std::size_t n, const T* x, const T* r, T edge, LinkedCells& ce
     over.check(nl.cap);
 }
 
-template <class T, class M>
-void search_walls(const ColumnState<T, M>& s, BoundaryList& bl)
+template <class T, class M, class S>
+void search_walls(const ColumnState<T, M, S>& s, BoundaryList& bl)
 {
     const std::size_t n = s.size(), nw = s.wall_count();
     std::fill(bl.count.begin(), bl.count.end(), Index(0));
@@ -98,7 +99,8 @@ void search_walls(const ColumnState<T, M>& s, BoundaryList& bl)
 
 // ---- the processor ---------------------------------------------------------------------------------
 
-template <class T, class M>
+// T: value type (double, float); M: model (model.hpp); S: integrator (integrators.hpp).
+template <class T, class M, class S = Gear5Scheme>
 class ArraysVariant final : public Variant {
 public:
     void init(const Setup& setup) override
@@ -110,9 +112,11 @@ public:
         nl_.cap = Index(scene.capacity.contacts_per_particle);
         nl_.count.assign(n, 0);
         nl_.partner.assign(n * std::size_t(nl_.cap), 0);
-        bl_.cap = Index(scene.capacity.wall_contacts_per_particle);
-        bl_.count.assign(n, 0);
-        bl_.wall.assign(n * std::size_t(bl_.cap), 0);
+        if constexpr (M::walls) {  // a model without walls holds no boundary list
+            bl_.cap = Index(scene.capacity.wall_contacts_per_particle);
+            bl_.count.assign(n, 0);
+            bl_.wall.assign(n * std::size_t(bl_.cap), 0);
+        }
         cells_.reserve(n);
     }
 
@@ -123,7 +127,7 @@ public:
         const std::size_t n = state_.size();
         if (cell_ > T(0)) search_cells(n, state_.x(), state_.r(), cell_, cells_, nl_);
         else search_all_pairs(n, state_.x(), state_.r(), nl_);
-        search_walls(state_, bl_);
+        if constexpr (M::walls) search_walls(state_, bl_);
     }
 
     void forces() override
@@ -139,11 +143,12 @@ public:
             for (Index k = 0; k < nl_.count[i]; ++k)
                 if (state_.pair(i, std::size_t(row[k]))) ++pp_;
         }
-        for (std::size_t i = 0; i < n; ++i) {
-            const Index* row = &bl_.wall[i * std::size_t(bl_.cap)];
-            for (Index k = 0; k < bl_.count[i]; ++k)
-                if (state_.wall(i, std::size_t(row[k]))) ++pw_;
-        }
+        if constexpr (M::walls)
+            for (std::size_t i = 0; i < n; ++i) {
+                const Index* row = &bl_.wall[i * std::size_t(bl_.cap)];
+                for (Index k = 0; k < bl_.count[i]; ++k)
+                    if (state_.wall(i, std::size_t(row[k]))) ++pw_;
+            }
         state_.newton();
     }
 
@@ -151,6 +156,7 @@ public:
     void snapshot(Snapshot& out) const override { state_.snapshot(out); }
     void save(State& out) const override { state_.save(out); }
     ContactCounts counts() const override { return {pp_, pw_, candidates_}; }
+    ModelFeatures model() const override { return ModelFeatures::of<M>(); }
 
     std::size_t memory_bytes() const override
     {
@@ -159,7 +165,7 @@ public:
     }
 
 private:
-    ColumnState<T, M> state_;
+    ColumnState<T, M, S> state_;
     T cell_ = T(0);
     NeighbourList nl_;
     BoundaryList bl_;
@@ -167,12 +173,30 @@ private:
     std::int64_t pp_ = 0, pw_ = 0, candidates_ = 0;
 };
 
+// The instantiation a run gets, picked in init(): the smallest model that covers what the scene needs
+// (with_model, model.hpp).
+std::unique_ptr<Variant> pick_arrays(const Setup& setup)
+{
+    const IntegratorChoice& choice = setup.scene->integrator;
+    if (choice.is_default())
+        return with_model(model_for(setup), []<class M>() -> std::unique_ptr<Variant> {
+            return std::make_unique<ArraysVariant<double, M>>();
+        });
+    // Another integrator or precision (scene.integrator) runs the general model: the model specialisations
+    // are instantiated for the paper's gear5 in double only, not for every (integrator, precision) pair.
+    return with_precision(choice.precision, [&](auto value) {
+        return with_scheme(choice.scheme, [](auto scheme) -> std::unique_ptr<Variant> {
+            return std::make_unique<ArraysVariant<decltype(value), FullModel, decltype(scheme)>>();
+        });
+    });
+}
+
 } // namespace
 
 void register_variant_arrays(Registry& r)
 {
     r.add({"arrays", "plain arrays, procedural, Fortran-90 style (the paper's DEMMAT_F90)",
-           [] { return std::make_unique<ArraysVariant<double, FullModel>>(); }});
+           [] { return std::make_unique<DispatchingVariant>(pick_arrays, /*all_integrators=*/true); }});
 }
 
 } // namespace demmat

@@ -11,29 +11,28 @@
 
 #include "demmat/contact_law.hpp"
 #include "demmat/gear.hpp"
+#include "demmat/integrators.hpp"
 #include "demmat/variant.hpp"
 
 namespace demmat {
 
 // ---- predictor and corrector: one loop over all 3N components --------------------------------------
+// S is the integrator (integrators.hpp; Gear5Scheme is the paper's gear_predict/gear_correct).
 
 // The six arrays never alias (Fortran assumes as much of its dummy arguments); __restrict says so, and
 // lets the compiler vectorise these loops (the element-wise operations, and so the bits, are the same).
-template <class T>
-void gear_predictor(std::size_t n3, T* __restrict x, T* __restrict v, T* __restrict a, T* __restrict b3, T* __restrict b4,
-                    const T* __restrict b5, const GearCoefficients<T>& k)
+template <class S, class T, class K>
+void predictor(std::size_t n3, T* __restrict x, T* __restrict v, T* __restrict a, T* __restrict b3, T* __restrict b4,
+               const T* __restrict b5, const K& k)
 {
-    for (std::size_t e = 0; e < n3; ++e) gear_predict(x[e], v[e], a[e], b3[e], b4[e], b5[e], k);
+    for (std::size_t e = 0; e < n3; ++e) S::predict(x[e], v[e], a[e], b3[e], b4[e], b5[e], k);
 }
 
-template <class T>
-void gear_corrector(std::size_t n3, T* __restrict x, T* __restrict v, T* __restrict a, T* __restrict b3, T* __restrict b4,
-                    T* __restrict b5, const T* __restrict a_new, const GearCoefficients<T>& k)
+template <class S, class T, class K>
+void corrector(std::size_t n3, T* __restrict x, T* __restrict v, T* __restrict a, T* __restrict b3, T* __restrict b4,
+               T* __restrict b5, const T* __restrict a_new, const K& k)
 {
-    for (std::size_t e = 0; e < n3; ++e) {
-        const T da = a_new[e] - a[e];
-        gear_correct(x[e], v[e], a[e], b3[e], b4[e], b5[e], da, k);
-    }
+    for (std::size_t e = 0; e < n3; ++e) S::correct(x[e], v[e], a[e], b3[e], b4[e], b5[e], a_new[e], k);
 }
 
 // Row i of an (N, 3) column-major array.
@@ -51,7 +50,8 @@ void add(T* a, std::size_t n, std::size_t i, const Vec3<T>& v)
 
 // Forces and torques are summed in the canonical order of physics.md §6 when the caller does: zero_loads(),
 // then pair(i, j) for the pairs in ascending (i, j), then wall(i, w) in wall order, then newton().
-template <class T, class M>
+// T is the value type (double or float), M the model (model.hpp), S the integrator (integrators.hpp).
+template <class T, class M, class S = Gear5Scheme>
 class ColumnState {
 public:
     void load(const Setup& setup)
@@ -60,7 +60,7 @@ public:
         const Scene& scene = *setup.scene;
         n_ = s.size();
         step_ = s.step;
-        gear_ = GearCoefficients<T>::make(scene.dt);
+        coef_ = SchemeCoefficients::make(scene.dt);
         params_ = setup.contact.template as<T>();
         g_ = cast<T>(scene.gravity);
         walls_ = s.walls;
@@ -89,6 +89,11 @@ public:
                 wv_[3 * w + c] = T(component(walls_[w].velocity, c));
             }
         place_walls(step_);
+        if constexpr (!M::polydisperse)  // one radius and mass: the contacts' coefficients once per run
+            if (n_ > 0) {
+                mono_pp_ = pair_coefficients(r_[0], r_[0], m_[0], m_[0], params_);
+                mono_pw_ = wall_coefficients(r_[0], m_[0], params_);
+            }
     }
 
     std::size_t size() const { return n_; }
@@ -101,10 +106,10 @@ public:
     void predict(std::int64_t step)
     {
         step_ = step;
-        gear_predictor(3 * n_, x_.data(), v_.data(), a_.data(), b3_.data(), b4_.data(), b5_.data(), gear_);
+        predictor<S>(3 * n_, x_.data(), v_.data(), a_.data(), b3_.data(), b4_.data(), b5_.data(), coef_);
         if constexpr (M::rotation)
-            gear_predictor(3 * n_, th_.data(), w_.data(), al_.data(), r3_.data(), r4_.data(), r5_.data(), gear_);
-        place_walls(step);
+            predictor<S>(3 * n_, th_.data(), w_.data(), al_.data(), r3_.data(), r4_.data(), r5_.data(), coef_);
+        if constexpr (M::moving_walls) place_walls(step);  // fixed walls stay where load() put them
     }
 
     void zero_loads()
@@ -119,7 +124,7 @@ public:
         const std::size_t n = n_;
         ContactForce<T> c;
         if (!particle_contact<M>(get(x_.data(), n, i), get(x_.data(), n, j), get(v_.data(), n, i), get(v_.data(), n, j),
-                                 get(w_.data(), n, i), get(w_.data(), n, j), r_[i], r_[j], m_[i], m_[j], params_, c))
+                                 get(w_.data(), n, i), get(w_.data(), n, j), r_[i], r_[j], m_[i], m_[j], params_, mono_pp_, c))
             return false;
         add(f_.data(), n, i, c.f_i);
         add(f_.data(), n, j, -c.f_i);
@@ -136,7 +141,7 @@ public:
         const std::size_t n = n_;
         ContactForce<T> c;
         if (!wall_contact<M>(get(x_.data(), n, i), get(v_.data(), n, i), get(w_.data(), n, i), r_[i], m_[i], wall_point(w),
-                             wall_normal(w), Vec3<T>{wv_[3 * w], wv_[3 * w + 1], wv_[3 * w + 2]}, params_, c))
+                             wall_normal(w), Vec3<T>{wv_[3 * w], wv_[3 * w + 1], wv_[3 * w + 2]}, params_, mono_pw_, c))
             return false;
         add(f_.data(), n, i, c.f_i);
         if constexpr (M::rotation) add(t_.data(), n, i, c.t_i);
@@ -157,9 +162,9 @@ public:
 
     void correct()
     {
-        gear_corrector(3 * n_, x_.data(), v_.data(), a_.data(), b3_.data(), b4_.data(), b5_.data(), acc_.data(), gear_);
+        corrector<S>(3 * n_, x_.data(), v_.data(), a_.data(), b3_.data(), b4_.data(), b5_.data(), acc_.data(), coef_);
         if constexpr (M::rotation)
-            gear_corrector(3 * n_, th_.data(), w_.data(), al_.data(), r3_.data(), r4_.data(), r5_.data(), alc_.data(), gear_);
+            corrector<S>(3 * n_, th_.data(), w_.data(), al_.data(), r3_.data(), r4_.data(), r5_.data(), alc_.data(), coef_);
     }
 
     void snapshot(Snapshot& out) const
@@ -202,8 +207,10 @@ private:
     std::size_t n_ = 0, nw_ = 0;
     std::int64_t step_ = 0;
     double dt_ = 0.0;
-    GearCoefficients<T> gear_;
+    using SchemeCoefficients = typename S::template Coefficients<T>;  // the integrator's per-run constants
+    SchemeCoefficients coef_;
     ContactParams<T> params_;
+    Coefficients<T> mono_pp_, mono_pw_;  // monodisperse models: the one pair's and wall contact's coefficients
     Vec3<T> g_;
     std::vector<Wall> walls_;
     std::vector<T> x_, v_, a_, b3_, b4_, b5_, th_, w_, al_, r3_, r4_, r5_;  // (N, 3) each

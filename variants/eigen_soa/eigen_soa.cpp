@@ -26,6 +26,7 @@
 #include <fmt/format.h>
 
 #include "demmat/error.hpp"
+#include "demmat/features.hpp"
 #include "demmat/linked_cells.hpp"
 #include "demmat/registry.hpp"
 
@@ -107,13 +108,20 @@ public:
         nw_ = walls_.size();
         wp_.assign(nw_, Vec3d{});
         place_walls(step_);
+        if constexpr (!M::polydisperse)  // one radius and mass: the contacts' coefficients once per run
+            if (n_ > 0) {
+                mono_pp_ = pair_coefficients(r_(0), r_(0), m_(0), m_(0), params_);
+                mono_pw_ = wall_coefficients(r_(0), m_(0), params_);
+            }
 
         nl_.cap = Index(scene.capacity.contacts_per_particle);
         nl_.offset.setZero(n_ + 1);
         nl_.partner.setZero(n_ * nl_.cap);
-        bl_.cap = Index(scene.capacity.wall_contacts_per_particle);
-        bl_.offset.setZero(n_ + 1);
-        bl_.wall.setZero(n_ * bl_.cap);
+        if constexpr (M::walls) {  // a model without walls holds no boundary list
+            bl_.cap = Index(scene.capacity.wall_contacts_per_particle);
+            bl_.offset.setZero(n_ + 1);
+            bl_.wall.setZero(n_ * bl_.cap);
+        }
         cells_.reserve(std::size_t(n_));
         pp_ = pw_ = candidates_ = 0;
     }
@@ -123,7 +131,7 @@ public:
         step_ = step;
         gear_predict(x_, v_, a_, b3_, b4_, b5_, gear_);  // V = Arr3: five whole-array statements
         if constexpr (M::rotation) gear_predict(th_, w_, al_, r3_, r4_, r5_, gear_);
-        place_walls(step);
+        if constexpr (M::moving_walls) place_walls(step);  // fixed walls stay where init() put them
     }
 
     void search() override
@@ -131,7 +139,7 @@ public:
         if (n_ == 0) return;
         if (cell_ > 0.0) search_cells();
         else search_all_pairs();
-        search_walls();
+        if constexpr (M::walls) search_walls();
     }
 
     void forces() override
@@ -151,7 +159,7 @@ public:
             for (Index k = begin; k < end; ++k) {
                 const Eigen::Index j = nl_.partner(k);
                 ContactForce<double> c;
-                if (!particle_contact<M>(xi, get(x_, j), vi, get(v_, j), wi, get(w_, j), ri, r_(j), mi, m_(j), params_, c))
+                if (!particle_contact<M>(xi, get(x_, j), vi, get(v_, j), wi, get(w_, j), ri, r_(j), mi, m_(j), params_, mono_pp_, c))
                     continue;
                 ++pp_;
                 add(f_, i, c.f_i);
@@ -162,18 +170,19 @@ public:
                 }
             }
         }
-        for (Eigen::Index i = 0; i < n_; ++i) {
-            for (Index k = bl_.offset(i), end = bl_.offset(i + 1); k < end; ++k) {
-                const auto w = std::size_t(bl_.wall(k));
-                ContactForce<double> c;
-                if (!wall_contact<M>(get(x_, i), get(v_, i), get(w_, i), r_(i), m_(i), wp_[w], walls_[w].normal,
-                                     walls_[w].velocity, params_, c))
-                    continue;
-                ++pw_;
-                add(f_, i, c.f_i);
-                if constexpr (M::rotation) add(t_, i, c.t_i);
+        if constexpr (M::walls)
+            for (Eigen::Index i = 0; i < n_; ++i) {
+                for (Index k = bl_.offset(i), end = bl_.offset(i + 1); k < end; ++k) {
+                    const auto w = std::size_t(bl_.wall(k));
+                    ContactForce<double> c;
+                    if (!wall_contact<M>(get(x_, i), get(v_, i), get(w_, i), r_(i), m_(i), wp_[w], walls_[w].normal,
+                                         walls_[w].velocity, params_, mono_pw_, c))
+                        continue;
+                    ++pw_;
+                    add(f_, i, c.f_i);
+                    if constexpr (M::rotation) add(t_, i, c.t_i);
+                }
             }
-        }
         // Newton with gravity, whole columns: a = F/m + g (division, then addition, as acceleration()).
         const double g[3] = {g_.x, g_.y, g_.z};
         for (int c = 0; c < 3; ++c) {
@@ -222,6 +231,7 @@ public:
     }
 
     ContactCounts counts() const override { return {pp_, pw_, candidates_}; }
+    ModelFeatures model() const override { return ModelFeatures::of<M>(); }
 
     std::size_t memory_bytes() const override
     {
@@ -318,6 +328,7 @@ private:
     double cell_ = 0.0;
     GearCoefficients<double> gear_;
     ContactParams<double> params_;
+    Coefficients<double> mono_pp_, mono_pw_;  // monodisperse models: the one pair's and wall contact's coefficients
     Vec3d g_;
     std::vector<Wall> walls_;
     std::vector<Vec3d> wp_;                                          // wall points at the current step
@@ -332,12 +343,20 @@ private:
     std::int64_t pp_ = 0, pw_ = 0, candidates_ = 0;
 };
 
+// The instantiation a run gets, picked in init(): the smallest model that covers what the scene needs.
+std::unique_ptr<Variant> pick_eigen_soa(const Setup& setup)
+{
+    return with_model(model_for(setup), []<class M>() -> std::unique_ptr<Variant> {
+        return std::make_unique<EigenSoaVariant<M>>();
+    });
+}
+
 } // namespace
 
 void register_variant_eigen_soa(Registry& r)
 {
     r.add({"eigen_soa", "Eigen structure of arrays, whole-array predictor and corrector",
-           [] { return std::make_unique<EigenSoaVariant<FullModel>>(); }});
+           [] { return std::make_unique<DispatchingVariant>(pick_eigen_soa); }});
 }
 
 } // namespace demmat

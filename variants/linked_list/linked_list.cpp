@@ -28,6 +28,7 @@
 #include <vector>
 
 #include "../arrays/column_state.hpp"
+#include "demmat/features.hpp"
 #include "demmat/linked_cells.hpp"
 #include "demmat/registry.hpp"
 
@@ -181,7 +182,7 @@ public:
         if constexpr (Rebuild) free_lists();
         if (cell_ > T(0)) search_cells();
         else search_all_pairs();
-        search_walls();
+        if constexpr (M::walls) search_walls();
     }
 
     void forces() override
@@ -195,9 +196,10 @@ public:
         for (std::size_t i = 0; i < n; ++i)
             for (const Node* node = pp_head_[i]; node != nullptr; node = node->next)
                 if (state_.pair(i, std::size_t(node->partner))) ++pp_;
-        for (std::size_t i = 0; i < n; ++i)
-            for (const Node* node = pw_head_[i]; node != nullptr; node = node->next)
-                if (state_.wall(i, std::size_t(node->partner))) ++pw_;
+        if constexpr (M::walls)
+            for (std::size_t i = 0; i < n; ++i)
+                for (const Node* node = pw_head_[i]; node != nullptr; node = node->next)
+                    if (state_.wall(i, std::size_t(node->partner))) ++pw_;
         state_.newton();
     }
 
@@ -205,6 +207,7 @@ public:
     void snapshot(Snapshot& out) const override { state_.snapshot(out); }
     void save(State& out) const override { state_.save(out); }
     ContactCounts counts() const override { return {pp_, pw_, candidates_}; }
+    ModelFeatures model() const override { return ModelFeatures::of<M>(); }
 
     std::size_t memory_bytes() const override
     {
@@ -296,16 +299,28 @@ private:
     std::int64_t pp_ = 0, pw_ = 0, candidates_ = 0;
 };
 
+// The instantiation a run gets, picked in init() as in arrays (the same ColumnState, the same models), so
+// that a comparison with arrays keeps isolating the contact store.
+template <class Nodes, bool Rebuild = false>
+std::unique_ptr<Variant> make_dispatching()
+{
+    return std::make_unique<DispatchingVariant>([](const Setup& setup) {
+        return with_model(model_for(setup), []<class M>() -> std::unique_ptr<Variant> {
+            return std::make_unique<LinkedListVariant<double, M, Nodes, Rebuild>>();
+        });
+    });
+}
+
 } // namespace
 
 void register_variant_linked_list(Registry& r)
 {
     r.add({"linked_list", "arrays state; persistent per-particle linked lists of contacts, nodes from new/delete",
-           [] { return std::make_unique<LinkedListVariant<double, FullModel, HeapNodes>>(); }});
+           [] { return make_dispatching<HeapNodes>(); }});
     r.add({"linked_list_pool", "arrays state; persistent per-particle linked lists of contacts, nodes from a recycled pool",
-           [] { return std::make_unique<LinkedListVariant<double, FullModel, PoolNodes>>(); }});
+           [] { return make_dispatching<PoolNodes>(); }});
     r.add({"linked_list_rebuild", "arrays state; per-particle linked lists rebuilt every step, a new/delete per contact",
-           [] { return std::make_unique<LinkedListVariant<double, FullModel, HeapNodes, true>>(); }});
+           [] { return make_dispatching<HeapNodes, true>(); }});
 }
 
 } // namespace demmat

@@ -56,26 +56,52 @@ inline bool may_touch_wall(const Vec3<T>& xi, T ri, const Vec3<T>& point, const 
     return dot(xi - point, normal) < ri * T(1.000000001);
 }
 
+// The contact's effective coefficients (physics.md §2): kn = (4/3)E*·sqrt(R*) multiplies h·sqrt(h),
+// cn = γ_n·m* multiplies u_n, ct = γ_t·m* multiplies |u_t|. A pair enters the law only through R* and m*,
+// so a polydisperse model computes these per contact and a monodisperse one once per run, for the one
+// radius and mass (pair_coefficients / wall_coefficients): the same operations, hence the same bits.
+template <class T>
+struct Coefficients {
+    T kn{}, cn{}, ct{};
+};
+
+template <class T>
+inline Coefficients<T> coefficients(T hertz, T rstar, T mstar, const ContactParams<T>& p)
+{
+    return {hertz * std::sqrt(rstar), p.gamma_n * mstar, p.gamma_t * mstar};
+}
+template <class T>
+inline Coefficients<T> pair_coefficients(T ri, T rj, T mi, T mj, const ContactParams<T>& p)
+{
+    return coefficients(p.hertz_pp, ri * rj / (ri + rj), mi * mj / (mi + mj), p);
+}
+template <class T>
+inline Coefficients<T> wall_coefficients(T ri, T mi, const ContactParams<T>& p)
+{
+    return coefficients(p.hertz_pw, ri, mi, p);  // R* = R_i, m* = m_i
+}
+
 namespace detail {
 
 // Normal and tangential force from the contact geometry (n from i towards the partner, overlap h > 0,
-// lever arm d_i, relative velocity u of i with respect to the partner at the contact point).
+// relative velocity u of i with respect to the partner at the contact point).
 template <class M, class T>
-inline void contact_force(const Vec3<T>& n, T h, const Vec3<T>& u, T rstar, T mstar, T hertz,
-                          const ContactParams<T>& p, Vec3<T>& f_i, Vec3<T>& f_t)
+inline void contact_force(const Vec3<T>& n, T h, const Vec3<T>& u, const Coefficients<T>& k, const ContactParams<T>& p,
+                          Vec3<T>& f_i, Vec3<T>& f_t)
 {
     // h^(3/2) as h·sqrt(h): sqrt is correctly rounded in every language, pow is not (physics.md §6).
-    T fn = hertz * std::sqrt(rstar) * h * std::sqrt(h);
+    // kn·h·sqrt(h) is (4/3)E*·sqrt(R*)·h·sqrt(h) evaluated left to right, as the ports write it.
+    T fn = k.kn * h * std::sqrt(h);
     T un{};
     if constexpr (M::damping || M::friction) un = dot(u, n);
-    if constexpr (M::damping) fn = fn + p.gamma_n * mstar * un;
+    if constexpr (M::damping) fn = fn + k.cn * un;
     if (fn < T(0)) fn = T(0);  // choice: no attraction at the end of a contact
     f_t = Vec3<T>{};
     if constexpr (M::friction) {
         const Vec3<T> ut = u - un * n;
         const T ut_abs = std::sqrt(dot(ut, ut));
         if (ut_abs > T(0)) {
-            const T ft = std::min(p.mu * fn, p.gamma_t * mstar * ut_abs);
+            const T ft = std::min(p.mu * fn, k.ct * ut_abs);
             f_t = (-ft) * (ut / ut_abs);
         }
     }
@@ -84,25 +110,26 @@ inline void contact_force(const Vec3<T>& n, T h, const Vec3<T>& u, T rstar, T ms
 
 } // namespace detail
 
-// Particle–particle contact, i < j by id. Returns false (and writes nothing) when h <= 0.
+// Particle–particle contact, i < j by id. Returns false (and writes nothing) when h <= 0. `mono` holds
+// pair_coefficients of the scene's one radius and mass; only a monodisperse model (!M::polydisperse)
+// reads it, a polydisperse one computes the pair's own from r_i, r_j, m_i, m_j.
 template <class M, class T>
 inline bool particle_contact(const Vec3<T>& xi, const Vec3<T>& xj, const Vec3<T>& vi, const Vec3<T>& vj,
                              const Vec3<T>& wi, const Vec3<T>& wj, T ri, T rj, T mi, T mj,
-                             const ContactParams<T>& p, ContactForce<T>& out)
+                             const ContactParams<T>& p, const Coefficients<T>& mono, ContactForce<T>& out)
 {
     const Vec3<T> dx = xj - xi;
     const T d = std::sqrt(dot(dx, dx));
     const T h = ri + rj - d;
     if (!(h > T(0))) return false;
     const Vec3<T> n = dx / d;
-    const T rstar = ri * rj / (ri + rj);
-    const T mstar = mi * mj / (mi + mj);
     const Vec3<T> di = (ri - h * T(0.5)) * n;
     const Vec3<T> dj = -((rj - h * T(0.5)) * n);
     Vec3<T> u = vi - vj;
     if constexpr (M::rotation) u = u + cross(wi, di) - cross(wj, dj);
     Vec3<T> ft;
-    detail::contact_force<M>(n, h, u, rstar, mstar, p.hertz_pp, p, out.f_i, ft);
+    if constexpr (M::polydisperse) detail::contact_force<M>(n, h, u, pair_coefficients(ri, rj, mi, mj, p), p, out.f_i, ft);
+    else detail::contact_force<M>(n, h, u, mono, p, out.f_i, ft);
     if constexpr (M::rotation) {
         out.t_i = cross(di, ft);
         out.t_j = cross(dj, -ft);
@@ -111,25 +138,48 @@ inline bool particle_contact(const Vec3<T>& xi, const Vec3<T>& xj, const Vec3<T>
     return true;
 }
 
+// The same for a polydisperse model, whose callers hold no monodisperse coefficients.
+template <class M, class T>
+inline bool particle_contact(const Vec3<T>& xi, const Vec3<T>& xj, const Vec3<T>& vi, const Vec3<T>& vj,
+                             const Vec3<T>& wi, const Vec3<T>& wj, T ri, T rj, T mi, T mj,
+                             const ContactParams<T>& p, ContactForce<T>& out)
+{
+    static_assert(M::polydisperse, "a monodisperse model needs the run's pair coefficients");
+    return particle_contact<M>(xi, xj, vi, vj, wi, wj, ri, rj, mi, mj, p, Coefficients<T>{}, out);
+}
+
 // Particle–wall contact: the wall is a plane through `point` with unit normal `normal` pointing into
-// the domain, moving with velocity `vw`; R* = R_i, m* = m_i, E* from the particle and wall materials.
+// the domain, moving with velocity `vw` (read only by a model with moving walls; a fixed wall's is
+// zero, and v_i − 0 = v_i exactly); R* = R_i, m* = m_i, E* from the particle and wall materials. `mono`
+// as for particle_contact, from wall_coefficients.
 template <class M, class T>
 inline bool wall_contact(const Vec3<T>& xi, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T mi,
                          const Vec3<T>& point, const Vec3<T>& normal, const Vec3<T>& vw,
-                         const ContactParams<T>& p, ContactForce<T>& out)
+                         const ContactParams<T>& p, const Coefficients<T>& mono, ContactForce<T>& out)
 {
     const T s = dot(xi - point, normal);
     const T h = ri - s;
     if (!(h > T(0))) return false;
     const Vec3<T> n = -normal;
     const Vec3<T> di = (ri - h * T(0.5)) * n;
-    Vec3<T> u = vi - vw;
+    Vec3<T> u = vi;
+    if constexpr (M::moving_walls) u = vi - vw;
     if constexpr (M::rotation) u = u + cross(wi, di);
     Vec3<T> ft;
-    detail::contact_force<M>(n, h, u, ri, mi, p.hertz_pw, p, out.f_i, ft);
+    if constexpr (M::polydisperse) detail::contact_force<M>(n, h, u, wall_coefficients(ri, mi, p), p, out.f_i, ft);
+    else detail::contact_force<M>(n, h, u, mono, p, out.f_i, ft);
     if constexpr (M::rotation) out.t_i = cross(di, ft);
     out.overlap = h;
     return true;
+}
+
+template <class M, class T>
+inline bool wall_contact(const Vec3<T>& xi, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T mi,
+                         const Vec3<T>& point, const Vec3<T>& normal, const Vec3<T>& vw,
+                         const ContactParams<T>& p, ContactForce<T>& out)
+{
+    static_assert(M::polydisperse, "a monodisperse model needs the run's wall coefficients");
+    return wall_contact<M>(xi, vi, wi, ri, mi, point, normal, vw, p, Coefficients<T>{}, out);
 }
 
 // Newton's second law with gravity (physics.md §4 step 7): a = F/m + g, α = T/I.

@@ -1,11 +1,12 @@
 #pragma once
 // The driver owns the clock: it calls a variant's phases in the paper's order and times each one.
-// Health checks (NaN, runaway speed, excessive overlap, a particle through a wall) run between steps,
-// outside the timed phases.
+// Health checks (NaN, runaway speed, excessive overlap, a particle through a wall, energy growth beyond
+// what gravity supplies; docs/stability.md) run between steps, outside the timed phases.
 #include <chrono>
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "demmat/variant.hpp"
 
@@ -45,6 +46,11 @@ private:
     PhaseTimes times_;
     Snapshot scratch_;
     double speed_bound_;
+    // Energy-growth check (docs/stability.md): start positions and energy, the tolerance's floor; off
+    // when a wall moves (its work is not tracked).
+    std::vector<Vec3d> x0_;
+    double energy0_ = 0.0, energy_floor_ = 0.0;
+    bool energy_check_ = false;
 };
 
 // Kinetic energy (translational + rotational) of a snapshot, summed in id order.

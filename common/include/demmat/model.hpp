@@ -1,18 +1,100 @@
 #pragma once
-// Compile-time model features. The shared kernels are templates on a Model so that a scene that does
-// not use a feature (friction, damping, rotation) can run a specialisation that does no work for it,
-// without a copy of the code (see docs/design.md, "Model features").
+// Compile-time model features. The shared kernels (contact_law.hpp) and the phases of the specialising
+// variants are templates on a Model, and test its flags with `if constexpr`, so that a scene that does
+// not use a feature runs an instantiation that does no work for it, without a copy of the code. A run
+// derives what its scene needs (features_of, features.hpp) and picks the smallest instantiated model
+// that has all of it (with_model, below). See docs/design.md, "Model features".
+#include <string>
+#include <utility>
 
 namespace demmat {
 
-template <bool Rotation, bool Friction, bool Damping>
+template <bool Rotation, bool Friction, bool Damping, bool Walls = true, bool MovingWalls = true, bool Polydisperse = true>
 struct Model {
-    static constexpr bool rotation = Rotation;  // torques and the rotational Gear state
-    static constexpr bool friction = Friction;  // tangential force (needs rotation to be meaningful)
-    static constexpr bool damping = Damping;    // velocity-dependent normal term
+    static_assert(!Friction || Rotation, "friction implies rotation (the tangential force is what makes torques)");
+    static_assert(!MovingWalls || Walls, "moving walls imply walls");
+    static constexpr bool rotation = Rotation;          // torques and the rotational Gear state
+    static constexpr bool friction = Friction;          // tangential force
+    static constexpr bool damping = Damping;            // velocity-dependent normal term γ_n·m*·u_n
+    static constexpr bool walls = Walls;                // wall search and particle–wall contacts
+    static constexpr bool moving_walls = MovingWalls;   // wall positions per step, wall velocity in u
+    static constexpr bool polydisperse = Polydisperse;  // R*, m* per contact (else once per run)
 };
 
 // The paper's full model: what every variant runs unless a scene asks for less.
-using FullModel = Model<true, true, true>;
+using FullModel = Model<true, true, true, true, true, true>;
+
+// The same flags at run time: what a scene needs (features_of) or what an instantiation models.
+struct ModelFeatures {
+    bool rotation = false, friction = false, damping = false, walls = false, moving_walls = false, polydisperse = false;
+
+    static constexpr ModelFeatures full() { return {true, true, true, true, true, true}; }
+    template <class M>
+    static constexpr ModelFeatures of() { return {M::rotation, M::friction, M::damping, M::walls, M::moving_walls, M::polydisperse}; }
+
+    // True when a model with these features computes everything `need` asks for.
+    constexpr bool covers(const ModelFeatures& need) const
+    {
+        return (rotation || !need.rotation) && (friction || !need.friction) && (damping || !need.damping) &&
+               (walls || !need.walls) && (moving_walls || !need.moving_walls) && (polydisperse || !need.polydisperse);
+    }
+    constexpr ModelFeatures operator|(const ModelFeatures& o) const
+    {
+        return {rotation || o.rotation, friction || o.friction, damping || o.damping, walls || o.walls,
+                moving_walls || o.moving_walls, polydisperse || o.polydisperse};
+    }
+    constexpr bool operator==(const ModelFeatures&) const = default;
+
+    // "rotation+friction+damping+walls+moving_walls+polydisperse", or "normal" with none of them.
+    std::string name() const
+    {
+        std::string s;
+        auto put = [&s](bool on, const char* n) {
+            if (!on) return;
+            if (!s.empty()) s += '+';
+            s += n;
+        };
+        put(rotation, "rotation");
+        put(friction, "friction");
+        put(damping, "damping");
+        put(walls, "walls");
+        put(moving_walls, "moving_walls");
+        put(polydisperse, "polydisperse");
+        return s.empty() ? "normal" : s;
+    }
+};
+
+namespace detail {
+template <class F>
+decltype(auto) branch(bool on, F&& f)
+{
+    return on ? std::forward<F>(f).template operator()<true>() : std::forward<F>(f).template operator()<false>();
+}
+} // namespace detail
+
+// Calls make.template operator()<M>() with the smallest instantiated model M that covers `need`, and
+// returns what it returns (every instantiation must return the same type, e.g. unique_ptr<Variant>).
+// The instantiated set, 2 × 2 × 3 × 2 = 24 models, leaves out the combinations that are never the
+// smallest cover of a real scene: friction without rotation (no torque without a tangential force is
+// impossible to use) and rotation without friction (rotation is needed without friction only to carry
+// a given initial spin; the rotation+friction model then runs, exactly, with μ·F_n or γ_t·m*·|u_t|
+// zero), moving walls without walls.
+template <class Make>
+decltype(auto) with_model(const ModelFeatures& need, Make&& make)
+{
+    const bool spin = need.rotation || need.friction;
+    const int walls = need.moving_walls ? 2 : need.walls ? 1 : 0;
+    return detail::branch(spin, [&]<bool RF>() -> decltype(auto) {
+        return detail::branch(need.damping, [&]<bool D>() -> decltype(auto) {
+            return detail::branch(need.polydisperse, [&]<bool P>() -> decltype(auto) {
+                switch (walls) {
+                case 0: return make.template operator()<Model<RF, RF, D, false, false, P>>();
+                case 1: return make.template operator()<Model<RF, RF, D, true, false, P>>();
+                default: return make.template operator()<Model<RF, RF, D, true, true, P>>();
+                }
+            });
+        });
+    });
+}
 
 } // namespace demmat

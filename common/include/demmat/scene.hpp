@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "demmat/contact_law.hpp"
+#include "demmat/integrators.hpp"
 #include "demmat/vec3.hpp"
 
 namespace demmat {
@@ -93,6 +94,7 @@ struct Scene {
     SearchParams search;
     Capacity capacity;
     Checks checks;
+    IntegratorChoice integrator;  // [integrator]; default gear5 in double (docs/accuracy.md)
 
     // Exactly one of these is the particle source.
     std::optional<GridGenerator> grid;

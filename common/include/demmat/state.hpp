@@ -33,6 +33,8 @@ struct State {
 // Binary state file (format in docs/state-format.md); written to a temporary file and renamed.
 void save_state(const State& state, const std::filesystem::path& file);
 State load_state(const std::filesystem::path& file);
+// The same from the file's bytes (label names the source in messages); every damage is an Error.
+State parse_state(const std::string& bytes, const std::string& label);
 
 // Walls of a run that starts from a saved state: a wall the state knows keeps its position; if the
 // scene gives it another velocity, its motion is re-anchored at the state's step (a new stage, such as
@@ -48,6 +50,7 @@ State initial_state(const Scene& scene);
 
 namespace demmat {
 // Refuses a time step above the Rayleigh time of the smallest particle (a scene that cannot be stable)
-// and returns a warning (empty if none) when Δt exceeds 0.2 of it, the usual rule of thumb.
+// and returns a warning (empty if none) when Δt exceeds 0.2 of it, the usual rule of thumb; likewise for
+// the Hertz contact time at the scene's largest impact speed (check_contact_time_step, stability.hpp).
 std::string check_time_step(const Scene& scene, const State& state);
 } // namespace demmat

@@ -23,6 +23,9 @@ struct Setup {
     std::vector<double> inertia;  // per particle, id order (sphere_inertia)
     double radius_max = 0.0;
     double cell_size = 0.0;       // m; 0 when the search is all pairs
+    // Features to model although the scene does not need them (tests of bit identity, benchmarks of a
+    // feature's cost); a specialising variant models features_of(scene, state) | widen (features.hpp).
+    ModelFeatures widen;
 
     static Setup make(const Scene& scene, const State& state);
 };
@@ -57,6 +60,13 @@ public:
     virtual void save(State& out) const = 0;      // the full state, for save-and-continue
     virtual ContactCounts counts() const = 0;
     virtual std::size_t memory_bytes() const = 0;  // bytes held for particles and contacts
+    // The model features the instantiation picked in init() computes (model.hpp); a variant that does
+    // not specialise runs the full model.
+    virtual ModelFeatures model() const { return ModelFeatures::full(); }
+    // Whether init() honours this integrator and precision (scene.integrator, integrators.hpp); the
+    // Driver refuses a run whose variant does not. A variant that integrates with the paper's Gear scheme
+    // in double only keeps this default.
+    virtual bool supports(const IntegratorChoice& choice) const { return choice.is_default(); }
 };
 
 } // namespace demmat

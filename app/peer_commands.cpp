@@ -1,0 +1,152 @@
+#include "peer_commands.hpp"
+
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <fstream>
+#include <iostream>
+
+#include <fmt/format.h>
+
+#include "demmat/driver.hpp"
+#include "demmat/error.hpp"
+#include "demmat/io.hpp"
+#include "demmat/peer_io.hpp"
+#include "demmat/registry.hpp"
+
+namespace fs = std::filesystem;
+
+namespace demmat {
+
+struct PeerCommands::Args {
+    CLI::App* exp = nullptr;
+    CLI::App* imp = nullptr;
+    CLI::App* dump = nullptr;
+    std::string scene, state, out, variant = "arrays";
+    double perturb = 0.0, skin = 0.0;
+    std::uint64_t seed = 1;
+    std::int64_t steps = 1000, every = 100;
+};
+
+PeerCommands::PeerCommands(CLI::App& app) : a_(std::make_unique<Args>())
+{
+    Args& a = *a_;
+    a.exp = app.add_subcommand("export-lammps",
+                               "Write a scene's particles as a LAMMPS data file, with LAMMPS and LIGGGHTS input fragments (docs/peers.md)");
+    a.exp->add_option("scene", a.scene, "Scene file (TOML)")->required();
+    a.exp->add_option("--state", a.state, "Take the particles from this state file instead of the scene's own source");
+    a.exp->add_option("--out,-o", a.out, "Data file to write (NAME.data); beside it NAME.lammps, NAME.liggghts, NAME_<wall>.stl")->required();
+    a.exp->add_option("--perturb", a.perturb, "Add random velocities with components uniform in [-A, A] m/s (an ensemble member)")
+        ->check(CLI::NonNegativeNumber);
+    a.exp->add_option("--seed", a.seed, "Seed of the perturbation");
+    a.exp->add_option("--skin", a.skin, "Neighbour skin of the peers (m); default half the smallest radius")->check(CLI::NonNegativeNumber);
+
+    a.imp = app.add_subcommand("import-lammps", "Read a LAMMPS data file or dump (last frame) into a state file for a scene");
+    a.imp->add_option("file", a.state, "LAMMPS data file or text dump")->required();
+    a.imp->add_option("--scene", a.scene, "The scene the particles belong to (materials, walls, time step)")->required();
+    a.imp->add_option("--out,-o", a.out, "State file to write")->required();
+
+    a.dump = app.add_subcommand("dump", "Run a scene with one variant and write LAMMPS-style dump frames (id radius x v omega)");
+    a.dump->add_option("scene", a.scene, "Scene file (TOML)")->required();
+    a.dump->add_option("--state", a.state, "Start from this state file instead of the scene's own source");
+    a.dump->add_option("--variant,-v", a.variant, "Variant name (see demmat list)");
+    a.dump->add_option("--steps,-n", a.steps, "Number of steps")->check(CLI::PositiveNumber);
+    a.dump->add_option("--every", a.every, "Steps between frames (the first frame is the initial state)")->check(CLI::PositiveNumber);
+    a.dump->add_option("--out,-o", a.out, "Dump file to write")->required();
+}
+
+PeerCommands::~PeerCommands() = default;
+
+namespace {
+
+// The scene's initial state, or the scene continued from another state file (its walls as a run from
+// that state would have them).
+State scene_state(Scene& scene, const std::string& state_file)
+{
+    if (!state_file.empty()) {
+        scene.grid.reset();
+        scene.particles.clear();
+        scene.state_file = state_file;
+    }
+    return initial_state(scene);
+}
+
+int cmd_export(const std::string& scene_file, const std::string& state_file, const std::string& out,
+               double perturb, std::uint64_t seed, double skin)
+{
+    Scene scene = load_scene(scene_file);
+    State state = scene_state(scene, state_file);
+    if (perturb > 0.0) perturb_velocities(state, perturb, seed);
+    const fs::path data = out;
+    if (data.filename().empty()) throw Error(fmt::format("export: '{}' is not a file name", out));
+    PeerOptions o;
+    o.data_name = data.filename().string();
+    o.mesh_prefix = data.stem().string();
+    o.skin = skin;
+    const PeerExport e = export_peers(scene, state, o);
+    const fs::path dir = data.parent_path();
+    // Meshes and fragments first, the data file last: a data file present means the set is complete.
+    for (const auto& [name, text] : e.meshes) write_atomically(dir / name, text);
+    write_atomically(dir / (data.stem().string() + ".lammps"), e.lammps);
+    if (!e.liggghts.empty()) write_atomically(dir / (data.stem().string() + ".liggghts"), e.liggghts);
+    else std::cerr << "demmat: warning: no LIGGGHTS fragment: " << e.note << "\n";
+    write_atomically(data, e.data);
+    return 0;
+}
+
+int cmd_import(const std::string& file, const std::string& scene_file, const std::string& out)
+{
+    const Scene scene = load_scene(scene_file);
+    const State s = import_peer_state(file, scene);
+    save_state(s, out);
+    return 0;
+}
+
+int cmd_dump(const std::string& scene_file, const std::string& state_file, const std::string& variant_name, std::int64_t steps, std::int64_t every, const std::string& out)
+{
+    Scene scene = load_scene(scene_file);
+    const State state = scene_state(scene, state_file);
+    const Setup setup = Setup::make(scene, state);
+    auto variant = registry().find(variant_name).create();
+    Driver driver(*variant, setup);
+    // Frames go to a temporary file beside the target, renamed at the end: complete or absent.
+    const fs::path target = out;
+    const fs::path tmp = target.string() + ".part";
+    {
+        std::ofstream f(tmp);
+        if (!f) throw Error(fmt::format("{}: cannot write: {}", tmp.string(), std::strerror(errno)));
+        Snapshot snap;
+        auto frame = [&](std::int64_t k) {
+            variant->snapshot(snap);
+            f << lammps_dump_frame(k, scene, state.radius, snap.position, snap.velocity, snap.angular_velocity);
+        };
+        frame(0);
+        try {
+            driver.run(steps, [&](std::int64_t k) { if (k % every == 0) frame(k); });
+        } catch (...) {
+            f.close();
+            fs::remove(tmp);
+            throw;
+        }
+        f.flush();
+        if (!f) {
+            fs::remove(tmp);
+            throw Error(fmt::format("{}: write failed", tmp.string()));
+        }
+    }
+    fs::rename(tmp, target);
+    return 0;
+}
+
+} // namespace
+
+int PeerCommands::dispatch()
+{
+    const Args& a = *a_;
+    if (*a.exp) return cmd_export(a.scene, a.state, a.out, a.perturb, a.seed, a.skin);
+    if (*a.imp) return cmd_import(a.state, a.scene, a.out);
+    if (*a.dump) return cmd_dump(a.scene, a.state, a.variant, a.steps, a.every, a.out);
+    return -1;
+}
+
+} // namespace demmat

@@ -1,0 +1,270 @@
+// What each model feature costs per step (issue 10; docs/design.md, "Model features").
+//
+// One monodisperse dense bed, settled once with every feature on (cached in --states-dir), then six
+// scenes made from it, each needing one feature more than the one before:
+//
+//   0 normal        Hertz normal force only: μ = 0, γ_n = 0, no walls, no spin
+//   1 +damping      γ_n = 60 1/s
+//   2 +friction     μ = 0.6 (γ_t = 60 1/s), with rotation and the settled bed's spins
+//   3 +walls        the closed box, fixed
+//   4 +moving walls x_max moving in at 0.5 m/s (the compression stage)
+//   5 +polydisperse level 4 with R*, m* computed per contact: on this monodisperse bed the feature is
+//                   inert, so the trajectory is level 4's bit for bit and the difference is its work alone
+//
+// Every level runs twice per variant: the specialised model the variant picks for the scene, and the
+// full model (Setup::widen), which on that scene gives the same trajectory bit for bit (tested in
+// tests/test_features.cpp) — the difference is what specialisation saves. Each benchmark run starts from
+// the settled state, takes 20 untimed steps, then exactly --steps timed steps (Iterations), so every
+// repetition of every benchmark covers the same stretch of trajectory. Phases are timed by the suite's
+// driver. Run with --benchmark_enable_random_interleaving=true --benchmark_repetitions=R
+// (scripts/run_features.sh) so machine drift hits every configuration alike.
+//
+// Own options (before Google Benchmark's): --n=N (2000), --steps=K (300), --states-dir=DIR (states),
+// --variants=a,b (arrays,eigen_soa).
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <iostream>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <benchmark/benchmark.h>
+#include <fmt/format.h>
+#include <nlohmann/json.hpp>
+
+#include "demmat/driver.hpp"
+#include "demmat/error.hpp"
+#include "demmat/features.hpp"
+#include "demmat/output.hpp"
+#include "demmat/registry.hpp"
+#include "demmat/scenes.hpp"
+#include "demmat/state.hpp"
+
+using namespace demmat;
+namespace fs = std::filesystem;
+using json = nlohmann::json;
+
+namespace {
+
+struct Options {
+    std::int64_t n = 2000;
+    std::int64_t steps = 300;
+    fs::path states_dir = "states";
+    std::vector<std::string> variants = {"arrays", "eigen_soa"};
+};
+Options opt;
+
+const double kSettleTime = 0.3;  // s: the bed has collapsed and is nearly at rest (about 6 contacts per grain)
+const std::int64_t kWarmup = 20;
+
+// The monodisperse dense bed: the dense-bed family with R_min = R_max.
+Scene mono_bed(std::int64_t n)
+{
+    Scene s = dense_bed_scene(n);
+    s.name = fmt::format("dense_bed_mono_{}", n);
+    s.grid->radius_min = s.grid->radius_max;
+    return s;
+}
+
+State settled_state(const Scene& bed)
+{
+    const fs::path file = opt.states_dir / fmt::format("{}_settled.state", bed.name);
+    const auto steps = std::int64_t(std::ceil(kSettleTime / bed.dt - 1e-9));
+    try {
+        State st = load_state(file);
+        if (st.fingerprint == bed.fingerprint(st.size()) && st.step == steps) return st;
+    } catch (const Error&) {
+    }
+    std::cerr << fmt::format("bench_features: settling {} for {} s ({} steps; cached in {})\n", bed.name, kSettleTime, steps,
+                             file.string());
+    const State grid = initial_state(bed);
+    const Setup setup = Setup::make(bed, grid);
+    auto v = registry().find("arrays").create();
+    Driver d(*v, setup);
+    d.run(steps);
+    State st;
+    v->save(st);
+    st.dt = bed.dt;
+    st.fingerprint = grid.fingerprint;
+    fs::create_directories(opt.states_dir);
+    save_state(st, file);
+    return st;
+}
+
+struct Level {
+    int index;
+    std::string name;
+    Scene scene;
+    State state;
+    ModelFeatures widen;  // level 5 only: the inert polydisperse kernel
+};
+
+// The six scenes, each with its own copy of the settled state (walls and spins as the level needs).
+std::vector<std::unique_ptr<Level>> make_levels(const Scene& bed, const State& settled)
+{
+    std::vector<std::unique_ptr<Level>> out;
+    auto add = [&](const std::string& name, auto&& change, bool spin, ModelFeatures widen = {}) {
+        auto l = std::make_unique<Level>();
+        l->index = int(out.size());
+        l->name = name;
+        l->scene = bed;
+        l->scene.name = bed.name + "_" + name;
+        change(l->scene);
+        l->state = settled;
+        if (!spin)
+            for (std::vector<Vec3d>* q : {&l->state.rot.x, &l->state.rot.v, &l->state.rot.a, &l->state.rot.b3, &l->state.rot.b4,
+                                          &l->state.rot.b5})
+                std::fill(q->begin(), q->end(), Vec3d{});
+        l->state.walls = continue_walls(l->scene, l->state);
+        l->widen = widen;
+        out.push_back(std::move(l));
+    };
+    auto normal = [](Scene& s) {
+        s.material.mu = 0.0;
+        s.material.gamma_n = 0.0;
+        s.walls.clear();
+    };
+    auto damping = [&](Scene& s) {
+        normal(s);
+        s.material.gamma_n = bed.material.gamma_n;
+    };
+    auto friction = [&](Scene& s) {
+        damping(s);
+        s.material.mu = bed.material.mu;
+    };
+    auto walls = [&](Scene& s) {
+        friction(s);
+        s.walls = bed.walls;
+    };
+    auto moving = [&](Scene& s) {
+        walls(s);
+        for (Wall& w : s.walls)
+            if (w.name == "x_max") w.velocity = {-0.5, 0.0, 0.0};
+    };
+    add("normal", normal, false);
+    add("damping", damping, false);
+    add("friction", friction, true);
+    add("walls", walls, true);
+    add("moving_walls", moving, true);
+    ModelFeatures poly;
+    poly.polydisperse = true;
+    add("polydisperse", moving, true, poly);
+    return out;
+}
+
+std::vector<std::unique_ptr<Level>> levels;
+
+void run_level(benchmark::State& st, const std::string& variant, const Level& level, bool full)
+{
+    Setup setup = Setup::make(level.scene, level.state);
+    setup.widen = full ? ModelFeatures::full() : level.widen;
+    auto v = registry().find(variant).create();
+    Driver driver(*v, setup);
+    for (std::int64_t k = 0; k < kWarmup; ++k) driver.step();
+    const PhaseTimes before = driver.times();
+    double contacts = 0.0;
+    for (auto _ : st) {
+        driver.step();
+        const ContactCounts c = v->counts();
+        contacts += 2.0 * double(c.particle_particle) + double(c.particle_wall);
+    }
+    const PhaseTimes& t = driver.times();
+    const double steps = double(st.iterations());
+    const double n = double(level.state.size());
+    st.counters["predict_s"] = (t.predict - before.predict) / steps;
+    st.counters["search_s"] = (t.search - before.search) / steps;
+    st.counters["forces_s"] = (t.forces - before.forces) / steps;
+    st.counters["correct_s"] = (t.correct - before.correct) / steps;
+    st.counters["total_s"] = (t.total() - before.total()) / steps;
+    st.counters["us_per_particle_step"] = (t.total() - before.total()) / steps / n * 1e6;
+    st.counters["contacts_per_particle"] = contacts / steps / n;  // mean over the timed steps
+    const json label = {{"family", "features"},
+                        {"variant", variant},
+                        {"level", level.index},
+                        {"level_name", level.name},
+                        {"kernel", full ? "full" : "specialised"},
+                        {"model", v->model().name()},
+                        {"scene_needs", features_of(level.scene, level.state).name()},
+                        {"particles", level.state.size()},
+                        {"steps", st.iterations()}};
+    st.SetLabel(label.dump());
+}
+
+void parse_own_options(int& argc, char** argv)
+{
+    int out = 1;
+    for (int i = 1; i < argc; ++i) {
+        const std::string a = argv[i];
+        auto value = [&](const char* key) -> const char* {
+            const std::size_t l = std::strlen(key);
+            return a.compare(0, l, key) == 0 ? argv[i] + l : nullptr;
+        };
+        auto count = [&](const char* key, const char* v) {
+            char* end = nullptr;
+            const long long x = std::strtoll(v, &end, 10);
+            if (end == v || *end != '\0' || x <= 0) throw Error(fmt::format("{} needs a positive integer, not '{}'", key, v));
+            return std::int64_t(x);
+        };
+        if (const char* v = value("--n=")) {
+            opt.n = count("--n", v);
+        } else if (const char* v = value("--steps=")) {
+            opt.steps = count("--steps", v);
+        } else if (const char* v = value("--states-dir=")) {
+            opt.states_dir = v;
+        } else if (const char* v = value("--variants=")) {
+            opt.variants.clear();
+            std::string cur;
+            for (const char* p = v;; ++p) {
+                if (*p == ',' || *p == '\0') {
+                    opt.variants.push_back(registry().find(cur).name);  // throws naming the known variants
+                    cur.clear();
+                    if (*p == '\0') break;
+                } else {
+                    cur += *p;
+                }
+            }
+        } else {
+            argv[out++] = argv[i];
+        }
+    }
+    argc = out;
+}
+
+} // namespace
+
+int main(int argc, char** argv)
+{
+    try {
+        parse_own_options(argc, argv);
+    } catch (const Error& e) {
+        std::cerr << "bench_features: " << e.what() << "\n";
+        return 2;
+    }
+    benchmark::Initialize(&argc, argv);
+    if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
+    try {
+        const Scene bed = mono_bed(opt.n);
+        const State settled = settled_state(bed);
+        levels = make_levels(bed, settled);
+    } catch (const Error& e) {
+        std::cerr << "bench_features: " << e.what() << "\n";
+        return 1;
+    }
+    for (const auto& variant : opt.variants)
+        for (const auto& level : levels)
+            for (bool full : {false, true})
+                benchmark::RegisterBenchmark(
+                    fmt::format("features/{}/{}_{}/{}/{}", variant, level->index, level->name, full ? "full" : "specialised", opt.n)
+                        .c_str(),
+                    [variant, l = level.get(), full](benchmark::State& st) { run_level(st, variant, *l, full); })
+                    ->Unit(benchmark::kMillisecond)
+                    ->Iterations(opt.steps);
+    const auto p = provenance_json();
+    for (const auto& [k, v] : p.items()) benchmark::AddCustomContext("demmat_" + k, v.is_string() ? v.get<std::string>() : v.dump());
+    benchmark::AddCustomContext("demmat_settle_time_s", fmt::format("{}", kSettleTime));
+    benchmark::AddCustomContext("demmat_warmup_steps", fmt::format("{}", kWarmup));
+    benchmark::RunSpecifiedBenchmarks();
+    benchmark::Shutdown();
+    return 0;
+}

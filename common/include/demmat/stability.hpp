@@ -1,0 +1,57 @@
+#pragma once
+// Time scales and energy bookkeeping for numerical stability (docs/stability.md): the Hertz contact
+// time of physics.md §8 at the scene's largest impact speed, the time-step check that `demmat run`
+// makes before starting, and the mechanical energy the driver's energy-growth check bounds.
+#include <string>
+#include <vector>
+
+#include "demmat/integrators.hpp"
+#include "demmat/scene.hpp"
+#include "demmat/state.hpp"
+#include "demmat/vec3.hpp"
+
+namespace demmat {
+
+// Undamped Hertz contact, head-on at relative normal speed v (physics.md §8): maximum overlap and
+// contact time t_c = 2.87·(m*²/(R*·E*²·v))^(1/5).
+double hertz_max_overlap(double mstar, double rstar, double estar, double speed);
+double hertz_contact_time(double mstar, double rstar, double estar, double speed);
+
+// The largest impact speed a scene can explain (docs/stability.md): v_p = fastest initial grain + a free
+// fall across the domain's diagonal + the fastest wall; two grains can meet head-on at 2·v_p, a single
+// grain meets a wall at v_p + the fastest wall.
+double impact_speed_bound(const Scene& scene, const State& state);
+
+// The shortest Hertz contact time of the scene at `speed`: the pair of two smallest grains, and (with
+// walls) the smallest grain against a wall, whichever is shorter.
+struct ContactTime {
+    double tc = 0.0;      // s
+    double speed = 0.0;   // m/s, the impact speed it was computed at
+    bool wall = false;    // true when the particle–wall contact is the shorter one
+};
+ContactTime shortest_contact_time(const Scene& scene, const State& state, double speed);
+
+// The largest Δt/t_c at which the integrator stayed stable in every two-body case of the stability study
+// (results/stability/, docs/stability.md), rounded down: above it `demmat run` refuses the scene.
+double stable_fraction_of_contact_time(Integrator scheme);
+// Above this Δt/t_c (fewer than 20 steps per contact) `demmat run` warns: the restitution is then off
+// by more than about 1 % for the paper's Gear scheme (docs/stability.md).
+inline constexpr double kWarnFractionOfContactTime = 0.05;
+
+// Refuses (throws Error, one line) a Δt above the scene's integrator's stability limit in units of the
+// shortest contact time at the largest impact speed; returns a warning (empty if none) above
+// kWarnFractionOfContactTime of it.
+std::string check_contact_time_step(const Scene& scene, const State& state);
+
+// Elastic energy stored in the Hertz contacts at positions x: (8/15)·E*·sqrt(R*)·h^(5/2) per contact
+// (physics.md §8), particle pairs and particle–wall contacts (walls at `step`).
+double elastic_energy(const std::vector<Vec3d>& x, const std::vector<double>& radius, const std::vector<Wall>& walls,
+                      std::int64_t step, double dt, const ContactParams<double>& params);
+
+// The energy-growth check (docs/stability.md): kinetic + elastic energy may not exceed what the grains
+// held at the start plus the work gravity has done since, Σ m_i·g·(x_i − x_i(0)), by more than this
+// fraction of (start energy + |work of gravity|) plus a floor. Walls that move are exempt (their work is
+// not tracked); the speed bound still applies.
+inline constexpr double kEnergyGrowthTolerance = 0.05;
+
+} // namespace demmat

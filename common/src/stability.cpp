@@ -1,0 +1,113 @@
+#include "demmat/stability.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include <fmt/format.h>
+
+#include "demmat/error.hpp"
+#include "demmat/reference.hpp"
+
+namespace demmat {
+
+double hertz_max_overlap(double mstar, double rstar, double estar, double speed)
+{
+    return std::pow(15.0 * mstar * speed * speed / (16.0 * estar * std::sqrt(rstar)), 0.4);
+}
+
+double hertz_contact_time(double mstar, double rstar, double estar, double speed)
+{
+    return 2.87 * std::pow(mstar * mstar / (rstar * estar * estar * speed), 0.2);
+}
+
+double impact_speed_bound(const Scene& scene, const State& state)
+{
+    double v0 = 0.0, vw = 0.0;
+    for (const Vec3d& v : state.trans.v) v0 = std::max(v0, std::sqrt(dot(v, v)));
+    for (const Wall& w : state.walls) vw = std::max(vw, std::sqrt(dot(w.velocity, w.velocity)));
+    const Vec3d ext = scene.domain.max - scene.domain.min;
+    const double fall = std::sqrt(2.0 * std::sqrt(dot(scene.gravity, scene.gravity)) * std::sqrt(dot(ext, ext)));
+    const double vp = v0 + fall + vw;
+    return state.size() > 1 ? 2.0 * vp : vp + vw;
+}
+
+ContactTime shortest_contact_time(const Scene& scene, const State& state, double speed)
+{
+    ContactTime out;
+    out.speed = speed;
+    if (state.size() == 0 || !(speed > 0.0)) return out;
+    const double rmin = *std::min_element(state.radius.begin(), state.radius.end());
+    const double m = sphere_mass(rmin, scene.material.density);
+    const ContactParams<double> p = scene.contact_params();
+    out.tc = INFINITY;
+    if (state.size() > 1) out.tc = hertz_contact_time(m / 2.0, rmin / 2.0, 0.75 * p.hertz_pp, speed);
+    if (!state.walls.empty()) {
+        const double tw = hertz_contact_time(m, rmin, 0.75 * p.hertz_pw, speed);
+        if (tw < out.tc) {
+            out.tc = tw;
+            out.wall = true;
+        }
+    }
+    if (!std::isfinite(out.tc)) out.tc = 0.0;  // one grain and no wall: no contact can happen
+    return out;
+}
+
+double stable_fraction_of_contact_time(Integrator scheme)
+{
+    // The lower envelope, rounded down, of the limits the stability study measured on the two-body scenes
+    // (head-on pair, sphere on a wall; restitution 0.2 … 1, E = 1e5 … 2e11 Pa, double and float) where only
+    // the driver's detection and the end of the contact count, in units of the t_c this check uses
+    // (results/stability/stability_default.md, docs/stability.md). A bed with viscous friction can need
+    // less (its tangential damping is a second stiffness): the warning below covers it.
+    switch (scheme) {
+    case Integrator::gear5: return 0.09;
+    case Integrator::gear3: return 0.35;
+    case Integrator::verlet: return 0.25;
+    case Integrator::symplectic_euler: return 0.025;
+    }
+    return 0.025;
+}
+
+std::string check_contact_time_step(const Scene& scene, const State& state)
+{
+    const double v = impact_speed_bound(scene, state);
+    const ContactTime ct = shortest_contact_time(scene, state, v);
+    if (!(ct.tc > 0.0)) return {};
+    const double ratio = scene.dt / ct.tc;
+    const double limit = stable_fraction_of_contact_time(scene.integrator.scheme);
+    const char* what = ct.wall ? "the smallest grain against a wall" : "two smallest grains";
+    if (ratio > limit)
+        throw Error(fmt::format("{}: time step {:g} s is {:.3g} of the Hertz contact time {:.3g} s ({} at the scene's largest "
+                                "impact speed {:.3g} m/s), above the {} stability limit {} of it: the run would be unstable; "
+                                "use dt <= {:.3g} s (or --allow-unstable)",
+                                scene.name, scene.dt, ratio, ct.tc, what, v, name(scene.integrator.scheme), limit,
+                                kWarnFractionOfContactTime * ct.tc));
+    if (ratio > kWarnFractionOfContactTime)
+        return fmt::format("time step {:g} s is {:.3g} of the Hertz contact time {:.3g} s ({} at the scene's largest impact "
+                           "speed {:.3g} m/s); above {} of it a contact takes fewer than {:.0f} steps and its restitution is inaccurate",
+                           scene.dt, ratio, ct.tc, what, v, kWarnFractionOfContactTime, 1.0 / kWarnFractionOfContactTime);
+    return {};
+}
+
+double elastic_energy(const std::vector<Vec3d>& x, const std::vector<double>& radius, const std::vector<Wall>& walls,
+                      std::int64_t step, double dt, const ContactParams<double>& params)
+{
+    // F = (4/3)E*·sqrt(R*)·h^(3/2) integrates to (2/5)·(4/3)E*·sqrt(R*)·h^(5/2) = (8/15)E*·sqrt(R*)·h^(5/2).
+    double e = 0.0;
+    for (const auto& [i, j] : contact_pairs(x, radius, false)) {
+        const Vec3d d = x[j] - x[i];
+        const double h = radius[i] + radius[j] - std::sqrt(dot(d, d));
+        const double rstar = radius[i] * radius[j] / (radius[i] + radius[j]);
+        e += 0.4 * params.hertz_pp * std::sqrt(rstar) * h * h * std::sqrt(h);
+    }
+    for (const Wall& w : walls) {
+        const Vec3d p = w.point_at(step, dt);
+        for (std::size_t i = 0; i < x.size(); ++i) {
+            const double h = radius[i] - dot(x[i] - p, w.normal);
+            if (h > 0.0) e += 0.4 * params.hertz_pw * std::sqrt(radius[i]) * h * h * std::sqrt(h);
+        }
+    }
+    return e;
+}
+
+} // namespace demmat

@@ -1,0 +1,62 @@
+#!/usr/bin/env bash
+# The fast variant's benchmark (docs/variants.md, "fast"): for each N, the dense bed settled once
+# (0.4 s simulated with fast on every core, kept in states/), then `demmat bench` of arrays, fast and
+# fast_unordered on the settled bed (walls at rest) at each thread count, interleaved repetitions,
+# medians; then 10^6 particles run a few steps to show they fit (peak memory from /usr/bin/time).
+# Writes results/fast/bench_settled_<N>_t<threads>.json (+ .txt) and results/fast/million.txt.
+# Usage: scripts/bench_fast.sh [--sizes "1000 10000 100000"] [--threads "1 2"] [--repetitions R]
+#                              [--settle-time T] [--no-million] [--build DIR]
+# Timed steps per repetition are 5·10^6/N (at least 20), so each sample is ~10^6–10^7 particle-steps.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+sizes="1000 10000 100000"; threads="1 2"; reps=5; settle=0.4; million=1; build=build
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --sizes) sizes="$2"; shift 2 ;;
+    --threads) threads="$2"; shift 2 ;;
+    --repetitions) reps="$2"; shift 2 ;;
+    --settle-time) settle="$2"; shift 2 ;;
+    --no-million) million=0; shift ;;
+    --build) build="$2"; shift 2 ;;
+    *) echo "bench_fast.sh: unknown option $1 (expected --sizes, --threads, --repetitions, --settle-time, --no-million, --build)" >&2; exit 2 ;;
+  esac
+done
+
+if [[ ! -x "$build/app/demmat" ]]; then
+  scripts/install_deps.sh
+  cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release
+fi
+cmake --build "$build" -j "$(nproc 2>/dev/null || echo 2)" --target demmat
+demmat=$build/app/demmat
+mkdir -p scenes states results/fast
+
+for n in $sizes; do
+  bed=scenes/dense_bed_${n}.toml
+  [[ -f "$bed" ]] || $demmat scene dense-bed --n "$n" -o "$bed"
+  state=states/dense_bed_${n}_settled_fast.state
+  if [[ ! -f "$state" ]]; then
+    echo "== settling the dense bed of $n particles ($settle s simulated, fast on every core; done once)"
+    $demmat run "$bed" --variant fast --time "$settle" --save "$state" -q --json results/fast/settle_${n}.json
+  fi
+  settled=scenes/dense_bed_${n}_settled.toml
+  # The settled bed continuing from its state, walls at rest (a compression stage of speed 0).
+  [[ -f "$settled" ]] || $demmat scene compression --from "$bed" --state "$state" --speed 0 -o "$settled"
+  steps=$(( 5000000 / n )); (( steps < 20 )) && steps=20
+  for t in $threads; do
+    echo "== N = $n, $t thread(s): $reps interleaved repetitions of $steps steps"
+    out=results/fast/bench_settled_${n}_t${t}
+    $demmat bench "$settled" --variants arrays,fast,fast_unordered --steps "$steps" --warmup 10 \
+      --repetitions "$reps" --threads "$t" --json "$out.json" | tee "$out.txt"
+  done
+done
+
+if [[ $million == 1 ]]; then
+  echo "== 10^6 particles: 20 steps of fast from the loose lattice (memory and time)"
+  big=scenes/dense_bed_1000000.toml
+  [[ -f "$big" ]] || $demmat scene dense-bed --n 1000000 -o "$big"
+  /usr/bin/time -v $demmat run "$big" --variant fast --steps 20 -q --json results/fast/million.json \
+    > results/fast/million.txt 2> results/fast/million_time.txt
+  grep -E "Maximum resident|Elapsed" results/fast/million_time.txt | tee -a results/fast/million.txt
+  cat results/fast/million.txt
+fi
+echo "results in results/fast/"

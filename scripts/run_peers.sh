@@ -1,0 +1,140 @@
+#!/usr/bin/env bash
+# The suite side by side with LAMMPS and LIGGGHTS on the same scenes (docs/peers.md): installs the peers
+# (Debian's lammps and liggghts), builds, settles the dense beds, exports every stage as a LAMMPS data
+# file so that every code starts from the identical particles, then
+#  1. the peer benchmark: every code on one core (OMP_NUM_THREADS=1, no MPI) for the loose grid, the
+#     settled bed and the compression stage, N in the list, repetitions interleaved (the codes' order
+#     rotated every repetition), timings from each code's own loop time; results/peers/bench_*.
+#  2. the physics cross-check: an ensemble of perturbed starts per code from the same particles, the
+#     kinetic energy and bed height while settling, the wall force while compressing; results/peers/physics_*.
+# Usage: scripts/run_peers.sh [--full] [--n "1000 2000"] [--steps K] [--repetitions R] [--variants LIST]
+#                             [--members M] [--physics-n N] [--bench-only] [--physics-only]
+#   --full  N = 1000 … 64000 (doubling), 500 steps, 5 repetitions, 8 ensemble members (the lead's run)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+ns="1000 2000 4000"; steps=200; reps=3; variants=all; members=4; phys_n=2000; warmup=20
+do_bench=1; do_phys=1
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --full) ns="1000 2000 4000 8000 16000 32000 64000"; steps=500; reps=5; members=8; shift ;;
+    --n) ns="$2"; shift 2 ;;
+    --steps) steps="$2"; shift 2 ;;
+    --repetitions) reps="$2"; shift 2 ;;
+    --variants) variants="$2"; shift 2 ;;
+    --members) members="$2"; shift 2 ;;
+    --physics-n) phys_n="$2"; shift 2 ;;
+    --bench-only) do_phys=0; shift ;;
+    --physics-only) do_bench=0; shift ;;
+    *) echo "run_peers.sh: unknown option $1 (expected --full, --n, --steps, --repetitions, --variants, --members, --physics-n, --bench-only, --physics-only)" >&2; exit 2 ;;
+  esac
+done
+
+scripts/install_deps.sh --optional
+build=${DEMMAT_BUILD_DIR:-build}   # another Release build folder may be named (shared machines)
+cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
+cmake --build "$build" --target demmat -j "$(nproc 2>/dev/null || echo 2)" >/dev/null
+demmat=$PWD/$build/app/demmat
+lmp=$(command -v lmp || true)
+liggghts=$(command -v liggghts || true)
+[[ -n "$lmp" ]] || { echo "run_peers.sh: LAMMPS (lmp) is not installed; scripts/install_deps.sh --optional installs it" >&2; exit 1; }
+export OMP_NUM_THREADS=1   # one core for every code; no mpirun
+work=$PWD/$build/peers      # scenes, states, data files and raw outputs (large, not kept in the repository)
+out=results/peers
+mkdir -p "$work" "$out"
+
+# Versions of the peers, for the results' provenance.
+{
+  echo "{"
+  echo "  \"lammps\": \"$($lmp -h | sed -n 's/^Large-scale Atomic.Molecular Massively Parallel Simulator - //p' | head -1)\","
+  echo "  \"lammps_package\": \"$(dpkg-query -W -f='${Version}' lammps 2>/dev/null)\","
+  if [[ -n "$liggghts" ]]; then
+    echo "  \"liggghts\": \"$($liggghts -h 2>&1 | sed -n 's/^LIGGGHTS (Version \([^,]*\),.*/\1/p' | head -1)\","
+    echo "  \"liggghts_package\": \"$(dpkg-query -W -f='${Version}' liggghts 2>/dev/null)\","
+  fi
+  echo "  \"mpi\": \"none (serial runs, OMP_NUM_THREADS=1)\""
+  echo "}"
+} > "$work/versions.json"
+
+# The three stages for N particles: loose grid (t = 0), settled bed (0.4 s, all walls fixed) and the
+# compression stage (x_max moving in at 0.5 m/s), each exported for the peers.
+prepare() {
+  local n=$1 d=$work/n$1
+  mkdir -p "$d"
+  [[ -f $d/loose.toml ]] || $demmat scene dense-bed --n "$n" -o "$d/loose.toml"
+  if [[ ! -f $d/settled.state ]]; then
+    echo "== settling the dense bed of $n particles (0.4 s simulated, once; kept in $d)"
+    $demmat run "$d/loose.toml" --variant arrays --time 0.4 --save "$d/settled.state" --quiet >/dev/null
+  fi
+  [[ -f $d/compression.toml ]] || $demmat scene compression --from "$d/loose.toml" --state "$d/settled.state" -o "$d/compression.toml"
+  [[ -f $d/bed.toml ]] || $demmat scene compression --from "$d/loose.toml" --state "$d/settled.state" --speed 0 -o "$d/bed.toml"
+  for stage in loose bed compression; do
+    [[ -f $d/$stage.data ]] || $demmat export-lammps "$d/$stage.toml" -o "$d/$stage.data"
+  done
+}
+
+# "Loop time of X on 1 procs for K steps": the timed (last) run's seconds.
+loop_time() { grep "^Loop time of" "$1" | tail -1 | awk '{print $4}'; }
+
+if [[ $do_bench == 1 ]]; then
+  samples=$work/bench_samples.csv
+  echo "code,variant,particles,stage,repetition,steps,seconds_per_step" > "$samples"
+  rm -f "$work"/suite_n*_*.json
+  for n in $ns; do prepare "$n"; done
+  codes=(suite lammps); [[ -n "$liggghts" ]] && codes+=(liggghts)
+  for ((r = 0; r < reps; r++)); do
+    for n in $ns; do
+      d=$work/n$n
+      for stage in loose bed compression; do
+        for ((q = 0; q < ${#codes[@]}; q++)); do
+          code=${codes[$(((q + r) % ${#codes[@]}))]}   # rotated each repetition: drift hits all alike
+          case $code in
+            suite)
+              $demmat bench "$d/$stage.toml" --variants "$variants" --steps "$steps" --warmup "$warmup" --repetitions 1 \
+                --json "$work/suite_n${n}_${stage}_r${r}.json" >/dev/null 2>&1 ;;
+            lammps)
+              (cd "$d" && $lmp -var frag "$stage.lammps" -var warmup "$warmup" -var steps "$steps" \
+                 -in "$OLDPWD/peers/lammps/in.bench" -log none -nocite > "$work/lammps.out" 2>&1)
+              echo "lammps,lammps,$n,$stage,$r,$steps,$(awk -v t="$(loop_time "$work/lammps.out")" -v k="$steps" 'BEGIN{printf "%.9e", t/k}')" >> "$samples" ;;
+            liggghts)
+              (cd "$d" && $liggghts -var frag "$stage.liggghts" -var warmup "$warmup" -var steps "$steps" \
+                 -in "$OLDPWD/peers/liggghts/in.bench" -log none -nocite > "$work/liggghts.out" 2>&1)
+              echo "liggghts,liggghts,$n,$stage,$r,$steps,$(awk -v t="$(loop_time "$work/liggghts.out")" -v k="$steps" 'BEGIN{printf "%.9e", t/k}')" >> "$samples" ;;
+          esac
+        done
+      done
+    done
+    echo "== benchmark repetition $((r + 1))/$reps done"
+  done
+  /usr/bin/python3 analysis/plot_peers.py bench --work "$work" --samples "$samples" --versions "$work/versions.json" \
+    --out "$out" --figure results/figures/peers_us_per_particle_step.png
+fi
+
+if [[ $do_phys == 1 ]]; then
+  n=$phys_n; prepare "$n"; d=$work/n$n; p=$work/physics_n$n
+  mkdir -p "$p"; rm -f "$p"/*.csv
+  settle_steps=30000; settle_every=1000; comp_steps=6000; comp_every=300; amplitude=1e-6
+  echo "== physics cross-check: $members perturbed starts per code, $n particles"
+  for ((m = 1; m <= members; m++)); do
+    for stage in loose compression; do
+      if [[ $stage == loose ]]; then k=$settle_steps; e=$settle_every; else k=$comp_steps; e=$comp_every; fi
+      base=$p/${stage}_m$m
+      # One perturbed start, written once, read by every code: the suite imports the same data file.
+      $demmat export-lammps "$d/$stage.toml" -o "$base.data" --perturb "$amplitude" --seed "$m"
+      $demmat import-lammps "$base.data" --scene "$d/$stage.toml" -o "$base.state"
+      $demmat dump "$d/$stage.toml" --state "$base.state" --steps "$k" --every "$e" -o "$base.suite.dump" 2>/dev/null
+      (cd "$p" && $lmp -var frag "$(basename "$base").lammps" -var steps "$k" -var every "$e" -var dumpfile "$(basename "$base").lammps.dump" \
+         -in "$OLDPWD/peers/lammps/in.trace" -log none -nocite > /dev/null 2>&1)
+      [[ -n "$liggghts" ]] && (cd "$p" && $liggghts -var frag "$(basename "$base").liggghts" -var steps "$k" -var every "$e" \
+         -var dumpfile "$(basename "$base").liggghts.dump" -in "$OLDPWD/peers/liggghts/in.trace" -log none -nocite > /dev/null 2>&1)
+      for code in suite lammps liggghts; do
+        [[ -f $base.$code.dump ]] || continue
+        /usr/bin/python3 analysis/plot_peers.py observables --dump "$base.$code.dump" --scene "$d/$stage.toml" \
+          --code "$code" --member "$m" --stage "$stage" -o "$p/obs_${stage}_${code}_m$m.csv"
+        rm -f "$base.$code.dump"   # frames are large; the observables are what is kept
+      done
+    done
+    echo "== member $m/$members done"
+  done
+  /usr/bin/python3 analysis/plot_peers.py physics --work "$p" --versions "$work/versions.json" --particles "$n" \
+    --amplitude "$amplitude" --out "$out" --figure results/figures/peers_physics_${n}.png
+fi

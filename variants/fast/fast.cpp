@@ -1,0 +1,620 @@
+// The fast variant: data-oriented, vectorised, OpenMP multi-threaded, and still bit-identical to arrays
+// for any number of threads (docs/variants.md, "fast").
+//
+// - Particles live in cell order (re-sorted at every neighbour-list rebuild) with their ids kept; the
+//   state is a structure of arrays, each vector quantity three contiguous component blocks (x then y
+//   then z) as in arrays, so the Gear predictor and corrector are single vectorised streams over 3N.
+// - The contact candidates come from a neighbour list with a skin, rebuilt only when a displacement
+//   check says it must be. The list is a superset of the contact set and the shared law alone decides
+//   h > 0, so the contacts, and with the canonical order the trajectory, are those of a search every step.
+// - The list holds each pair once, under its lower-id particle (the law's i), partners sorted by id, in
+//   one array of slots kept across steps. The pair kernel writes each contact's force and torques into
+//   its slot (any thread, any order); then each particle gathers, in the canonical order of physics.md
+//   §6, the slots where it is j (partners of lower id, ascending; a list also kept across steps), then
+//   its own slots (partners of higher id, ascending, contiguous), then its walls, and applies Newton's
+//   law. No sum depends on which thread did what, so the bits do not depend on the thread count.
+// - FastOptions::canonical = false drops the canonical order: each pair's force is added to both
+//   particles as it is computed (a thread adds to the particles of its own range directly and queues
+//   those of another thread's range, applied after a barrier), which is what an unordered code does.
+#include "fast.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <utility>
+#include <vector>
+
+#include <fmt/format.h>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
+
+#include "demmat/contact_law.hpp"
+#include "demmat/error.hpp"
+#include "demmat/gear.hpp"
+#include "demmat/linked_cells.hpp"
+#include "demmat/registry.hpp"
+
+namespace demmat {
+namespace {
+
+#ifdef _OPENMP
+int thread_index() { return omp_get_thread_num(); }
+int thread_count() { return omp_get_num_threads(); }
+int thread_limit() { return omp_get_max_threads(); }
+#else
+int thread_index() { return 0; }
+int thread_count() { return 1; }
+int thread_limit() { return 1; }
+#endif
+
+using Index = std::int32_t;
+
+// One contact's result, kept in list order: force on i (on j it is -f), torque on i and on j.
+template <class T>
+struct Slot {
+    Vec3<T> f, ti, tj;
+};
+
+// A contribution for a particle in another thread's range (unordered mode only).
+template <class T>
+struct Foreign {
+    Index q;
+    Vec3<T> f, t;
+};
+
+template <class T, class M>
+class Fast final : public FastVariant {
+public:
+    explicit Fast(const FastOptions& o) : opt_(o) {}
+
+    void init(const Setup& setup) override
+    {
+        const State& s = *setup.state;
+        const Scene& scene = *setup.scene;
+        n_ = s.size();
+        step_ = s.step;
+        dt_ = scene.dt;
+        gear_ = GearCoefficients<T>::make(scene.dt);
+        params_ = setup.contact.template as<T>();
+        g_ = cast<T>(scene.gravity);
+        walls_ = s.walls;
+        nw_ = walls_.size();
+        // Below ~1000 particles a fork and join per phase costs more than the work it shares.
+        par_ = n_ >= 1000;
+        skin_ = T(opt_.skin * setup.radius_max);
+        // Cells at least as wide as the longest listed pair; a wider scene cell is honoured (it only
+        // changes the candidates, never the contact set).
+        cell_ = T(std::max(setup.cell_size, 2.0 * setup.radius_max)) + skin_;
+        for (auto* arr : {&x_, &v_, &a_, &b3_, &b4_, &b5_, &th_, &w_, &al_, &r3_, &r4_, &r5_, &f_, &t_, &acc_, &alc_, &xref_, &tmp_})
+            arr->assign(3 * n_, T(0));
+        auto load = [this](std::vector<T>& dst, const std::vector<Vec3d>& src) {
+            for (std::size_t i = 0; i < n_; ++i)
+                for (int c = 0; c < 3; ++c) dst[c * n_ + i] = T(component(src[i], c));
+        };
+        load(x_, s.trans.x); load(v_, s.trans.v); load(a_, s.trans.a);
+        load(b3_, s.trans.b3); load(b4_, s.trans.b4); load(b5_, s.trans.b5);
+        load(th_, s.rot.x); load(w_, s.rot.v); load(al_, s.rot.a);
+        load(r3_, s.rot.b3); load(r4_, s.rot.b4); load(r5_, s.rot.b5);
+        r_.resize(n_); m_.resize(n_); I_.resize(n_); id_.resize(n_); pos_.resize(n_); tmp1_.resize(n_); tmpi_.resize(n_);
+        for (std::size_t i = 0; i < n_; ++i) {
+            r_[i] = T(s.radius[i]);
+            m_[i] = T(setup.mass[i]);
+            I_[i] = T(setup.inertia[i]);
+            id_[i] = Index(i);
+        }
+        wp_.assign(3 * nw_, T(0)); wn_.assign(3 * nw_, T(0)); wv_.assign(3 * nw_, T(0));
+        for (std::size_t w = 0; w < nw_; ++w)
+            for (int c = 0; c < 3; ++c) {
+                wn_[3 * w + c] = T(component(walls_[w].normal, c));
+                wv_[3 * w + c] = T(component(walls_[w].velocity, c));
+            }
+        place_walls(step_);
+        pstart_.assign(n_ + 1, 0);
+        lstart_.assign(n_ + 1, 0);
+        key_.resize(n_);
+        rebuilds_ = 0;
+        rebuild();
+    }
+
+    void predict(std::int64_t step) override
+    {
+        step_ = step;
+        const std::size_t n3 = 3 * n_;
+        const GearCoefficients<T> k = gear_;
+        T* __restrict x = x_.data(); T* __restrict v = v_.data(); T* __restrict a = a_.data();
+        T* __restrict b3 = b3_.data(); T* __restrict b4 = b4_.data(); const T* __restrict b5 = b5_.data();
+        T* __restrict th = th_.data(); T* __restrict w = w_.data(); T* __restrict al = al_.data();
+        T* __restrict r3 = r3_.data(); T* __restrict r4 = r4_.data(); const T* __restrict r5 = r5_.data();
+#pragma omp parallel if (par_)
+        {
+#pragma omp for simd schedule(static) nowait
+            for (std::size_t e = 0; e < n3; ++e) gear_predict(x[e], v[e], a[e], b3[e], b4[e], b5[e], k);
+            if constexpr (M::rotation) {
+#pragma omp for simd schedule(static) nowait
+                for (std::size_t e = 0; e < n3; ++e) gear_predict(th[e], w[e], al[e], r3[e], r4[e], r5[e], k);
+            }
+        }
+        place_walls(step);
+    }
+
+    void search() override
+    {
+        // Rebuild when a pair may have closed by more than the skin since the last rebuild:
+        // |Δx_i| + |Δx_j| ≤ 2·max|Δx|. 0.9 leaves room for rounding; a NaN fails the test and goes to
+        // the rebuild, whose cell search reports it. (Walls need no list: see walls_of.)
+        const T half = T(0.9) * skin_ * T(0.5);
+        bool need = !(half > T(0));
+        if (!need) {
+            const T lim2 = half * half;
+            const std::size_t n = n_;
+            const T* __restrict x = x_.data();
+            const T* __restrict xr = xref_.data();
+            int over = 0;
+#pragma omp parallel for simd schedule(static) reduction(| : over) if (par_)
+            for (std::size_t s = 0; s < n; ++s) {
+                const T dx = x[s] - xr[s], dy = x[n + s] - xr[n + s], dz = x[2 * n + s] - xr[2 * n + s];
+                over |= int(!(dx * dx + dy * dy + dz * dz <= lim2));
+            }
+            need = over != 0;
+        }
+        if (need) rebuild();
+    }
+
+    void forces() override
+    {
+        if (opt_.canonical) forces_canonical();
+        else forces_unordered();
+    }
+
+    void correct() override
+    {
+        const std::size_t n3 = 3 * n_;
+        const GearCoefficients<T> k = gear_;
+        T* __restrict x = x_.data(); T* __restrict v = v_.data(); T* __restrict a = a_.data();
+        T* __restrict b3 = b3_.data(); T* __restrict b4 = b4_.data(); T* __restrict b5 = b5_.data();
+        T* __restrict th = th_.data(); T* __restrict w = w_.data(); T* __restrict al = al_.data();
+        T* __restrict r3 = r3_.data(); T* __restrict r4 = r4_.data(); T* __restrict r5 = r5_.data();
+        const T* __restrict acc = acc_.data();
+        const T* __restrict alc = alc_.data();
+#pragma omp parallel if (par_)
+        {
+#pragma omp for simd schedule(static) nowait
+            for (std::size_t e = 0; e < n3; ++e) {
+                const T da = acc[e] - a[e];
+                gear_correct(x[e], v[e], a[e], b3[e], b4[e], b5[e], da, k);
+            }
+            if constexpr (M::rotation) {
+#pragma omp for simd schedule(static) nowait
+                for (std::size_t e = 0; e < n3; ++e) {
+                    const T da = alc[e] - al[e];
+                    gear_correct(th[e], w[e], al[e], r3[e], r4[e], r5[e], da, k);
+                }
+            }
+        }
+    }
+
+    void snapshot(Snapshot& out) const override
+    {
+        out.resize(n_);
+        out.step = step_;
+        for (std::size_t i = 0; i < n_; ++i) {
+            const std::size_t s = std::size_t(pos_[i]);
+            out.position[i] = cast<double>(get(x_, s));
+            out.velocity[i] = cast<double>(get(v_, s));
+            out.angular_velocity[i] = cast<double>(get(w_, s));
+            out.force[i] = cast<double>(get(f_, s));
+            out.torque[i] = cast<double>(get(t_, s));
+        }
+    }
+
+    void save(State& out) const override
+    {
+        out.resize(n_);
+        out.step = step_;
+        out.walls = walls_;
+        const std::vector<T>* src[12] = {&x_, &v_, &a_, &b3_, &b4_, &b5_, &th_, &w_, &al_, &r3_, &r4_, &r5_};
+        std::vector<Vec3d>* dst[12] = {&out.trans.x, &out.trans.v, &out.trans.a, &out.trans.b3, &out.trans.b4, &out.trans.b5,
+                                       &out.rot.x,   &out.rot.v,   &out.rot.a,   &out.rot.b3,   &out.rot.b4,   &out.rot.b5};
+        for (int k = 0; k < 12; ++k)
+            for (std::size_t i = 0; i < n_; ++i) (*dst[k])[i] = cast<double>(get(*src[k], std::size_t(pos_[i])));
+        for (std::size_t i = 0; i < n_; ++i) out.radius[i] = double(r_[std::size_t(pos_[i])]);
+    }
+
+    ContactCounts counts() const override { return {pp_, pw_, std::int64_t(partner_.size())}; }
+    std::int64_t rebuilds() const override { return rebuilds_; }
+
+    std::size_t memory_bytes() const override
+    {
+        std::size_t b = 0;
+        for (const auto* arr : {&x_, &v_, &a_, &b3_, &b4_, &b5_, &th_, &w_, &al_, &r3_, &r4_, &r5_, &f_, &t_, &acc_, &alc_, &xref_, &tmp_,
+                                &r_, &m_, &I_, &tmp1_})
+            b += arr->capacity() * sizeof(T);
+        for (const auto* arr : {&id_, &pos_, &tmpi_, &pstart_, &partner_, &owner_, &lstart_, &lslot_, &cstart_})
+            b += arr->capacity() * sizeof(Index);
+        b += slot_.capacity() * sizeof(Slot<T>) + key_.capacity() * sizeof(key_[0]) + cell3_.capacity() * sizeof(std::int64_t);
+        for (const auto& f : foreign_) b += f.capacity() * sizeof(Foreign<T>);
+        return b;
+    }
+
+private:
+    Vec3<T> get(const std::vector<T>& a, std::size_t s) const { return {a[s], a[n_ + s], a[2 * n_ + s]}; }
+    void put(std::vector<T>& a, std::size_t s, const Vec3<T>& v)
+    {
+        a[s] = v.x;
+        a[n_ + s] = v.y;
+        a[2 * n_ + s] = v.z;
+    }
+    Vec3<T> wall_point(std::size_t w) const { return {wp_[3 * w], wp_[3 * w + 1], wp_[3 * w + 2]}; }
+    Vec3<T> wall_normal(std::size_t w) const { return {wn_[3 * w], wn_[3 * w + 1], wn_[3 * w + 2]}; }
+    Vec3<T> wall_velocity(std::size_t w) const { return {wv_[3 * w], wv_[3 * w + 1], wv_[3 * w + 2]}; }
+
+    void place_walls(std::int64_t step)
+    {
+        for (std::size_t w = 0; w < nw_; ++w) {
+            const Vec3d p = walls_[w].point_at(step, dt_);
+            for (int c = 0; c < 3; ++c) wp_[3 * w + c] = T(component(p, c));
+        }
+    }
+
+    // The contact of slot k (owner s, partner q; id(s) < id(q)), or zeros. Zeros add nothing: a sum that
+    // starts at +0 is never -0, and x + ±0 = x for every other x, so adding a rejected slot's zeros
+    // leaves the bits of arrays, which skips it.
+    bool pair(std::size_t s, std::size_t q, Slot<T>& out) const
+    {
+        const Vec3<T> xs = get(x_, s), xq = get(x_, q);
+        ContactForce<T> c;
+        // may_touch first: a cheap, conservative test (the law rejects every pair it rejects), so the
+        // skin's extra candidates cost a distance, not a square root.
+        if (may_touch(xs, xq, r_[s], r_[q]) &&
+            particle_contact<M>(xs, xq, get(v_, s), get(v_, q), get(w_, s), get(w_, q), r_[s], r_[q], m_[s], m_[q], params_, c)) {
+            out.f = c.f_i;
+            out.ti = c.t_i;
+            out.tj = c.t_j;
+            return true;
+        }
+        out = Slot<T>{};
+        return false;
+    }
+
+    void forces_canonical()
+    {
+        const std::size_t n = n_;
+        std::int64_t pp = 0, pw = 0;
+        const Index* pstart = pstart_.data();
+        const Index* partner = partner_.data();
+        const Index* lstart = lstart_.data();
+        const Index* lslot = lslot_.data();
+        Slot<T>* slot = slot_.data();
+#pragma omp parallel if (par_)
+        {
+            // Every contact once, into its slot.
+#pragma omp for schedule(static) reduction(+ : pp)
+            for (std::size_t s = 0; s < n; ++s)
+                for (Index k = pstart[s]; k < pstart[s + 1]; ++k) pp += pair(s, std::size_t(partner[k]), slot[k]);
+            // Each particle's sum in the canonical order: as j (partners of lower id, ascending), as i
+            // (partners of higher id, ascending), its walls in wall order; then Newton.
+#pragma omp for schedule(static) reduction(+ : pw)
+            for (std::size_t s = 0; s < n; ++s) {
+                Vec3<T> F{}, Tq{};
+                for (Index e = lstart[s]; e < lstart[s + 1]; ++e) {
+                    const Slot<T>& c = slot[lslot[e]];
+                    F += -c.f;
+                    if constexpr (M::rotation) Tq += c.tj;
+                }
+                for (Index k = pstart[s]; k < pstart[s + 1]; ++k) {
+                    const Slot<T>& c = slot[k];
+                    F += c.f;
+                    if constexpr (M::rotation) Tq += c.ti;
+                }
+                pw += walls_of(s, F, Tq);
+                finish(s, F, Tq);
+            }
+        }
+        pp_ = pp;
+        pw_ = pw;
+    }
+
+    // Walls of particle s in wall order, added to F and Tq; returns the contacts found. A scene has a
+    // handful of walls: testing each every step (may_touch_wall, a dot product) costs less than a wall
+    // list, and keeps the moving wall out of the rebuild criterion.
+    std::int64_t walls_of(std::size_t s, Vec3<T>& F, Vec3<T>& Tq) const
+    {
+        std::int64_t found = 0;
+        for (std::size_t w = 0; w < nw_; ++w) {
+            ContactForce<T> cf;
+            if (!may_touch_wall(get(x_, s), r_[s], wall_point(w), wall_normal(w))) continue;
+            if (!wall_contact<M>(get(x_, s), get(v_, s), get(w_, s), r_[s], m_[s], wall_point(w), wall_normal(w), wall_velocity(w),
+                                 params_, cf))
+                continue;
+            F += cf.f_i;
+            if constexpr (M::rotation) Tq += cf.t_i;
+            ++found;
+        }
+        return found;
+    }
+
+    // Stores the loads of s and applies Newton's law: a = F/m + g, α = T/I.
+    void finish(std::size_t s, const Vec3<T>& F, const Vec3<T>& Tq)
+    {
+        put(f_, s, F);
+        put(t_, s, Tq);
+        put(acc_, s, {acceleration(F.x, m_[s], g_.x), acceleration(F.y, m_[s], g_.y), acceleration(F.z, m_[s], g_.z)});
+        if constexpr (M::rotation) put(alc_, s, {Tq.x / I_[s], Tq.y / I_[s], Tq.z / I_[s]});
+    }
+
+    void add(std::vector<T>& a, std::size_t s, const Vec3<T>& v)
+    {
+        a[s] += v.x;
+        a[n_ + s] += v.y;
+        a[2 * n_ + s] += v.z;
+    }
+
+    void forces_unordered()
+    {
+        const std::size_t n = n_;
+        const int limit = thread_limit();
+        if (foreign_.size() < std::size_t(limit)) foreign_.resize(std::size_t(limit));
+        std::int64_t pp = 0, pw = 0;
+#pragma omp parallel reduction(+ : pp, pw) if (par_)
+        {
+            const std::size_t nt = std::size_t(thread_count()), t = std::size_t(thread_index());
+            const std::size_t lo = n * t / nt, hi = n * (t + 1) / nt;
+            for (std::size_t s = lo; s < hi; ++s) {
+                put(f_, s, {});
+                put(t_, s, {});
+            }
+            std::vector<Foreign<T>>& queue = foreign_[t];
+            queue.clear();
+#pragma omp barrier
+            for (std::size_t s = lo; s < hi; ++s) {
+                Vec3<T> F{}, Tq{};
+                for (Index k = pstart_[s]; k < pstart_[s + 1]; ++k) {
+                    const std::size_t q = std::size_t(partner_[k]);
+                    Slot<T> c;
+                    if (!pair(s, q, c)) continue;
+                    ++pp;
+                    F += c.f;
+                    if constexpr (M::rotation) Tq += c.ti;
+                    if (q >= lo && q < hi) {
+                        add(f_, q, -c.f);
+                        if constexpr (M::rotation) add(t_, q, c.tj);
+                    } else {
+                        queue.push_back({Index(q), -c.f, c.tj});
+                    }
+                }
+                pw += walls_of(s, F, Tq);
+                add(f_, s, F);
+                add(t_, s, Tq);
+            }
+#pragma omp barrier
+            for (std::size_t u = 0; u < nt; ++u)
+                for (const Foreign<T>& e : foreign_[u])
+                    if (std::size_t(e.q) >= lo && std::size_t(e.q) < hi) {
+                        add(f_, std::size_t(e.q), e.f);
+                        if constexpr (M::rotation) add(t_, std::size_t(e.q), e.t);
+                    }
+            for (std::size_t s = lo; s < hi; ++s) finish(s, get(f_, s), get(t_, s));
+        }
+        pp_ = pp;
+        pw_ = pw;
+    }
+
+    // ---- the neighbour list ---------------------------------------------------------------------
+
+    // Re-sorts the particles into cell order and lists, for each particle, its partners of higher id
+    // closer than R_i + R_j + skin (ascending id) and the slots where it is the partner (ascending id
+    // of the owner).
+    void rebuild()
+    {
+        ++rebuilds_;
+        const std::size_t n = n_;
+        if (n == 0) return;
+        // Cells over the bounding box, padded by one empty layer so that cx ± 1 stays inside; key =
+        // linear cell index, x fastest, so the three cells of a row are one key range.
+        cell3_.resize(3 * n);
+        T lo[3];
+        std::int64_t dims[3];
+        std::size_t ends[3][2];  // slots of the lowest and highest particle on each axis
+        for (int c = 0; c < 3; ++c) {
+            const T* xc = x_.data() + std::size_t(c) * n;
+            std::int64_t* qc = cell3_.data() + std::size_t(c) * n;
+            ends[c][0] = std::size_t(std::min_element(xc, xc + n) - xc);
+            ends[c][1] = ends[c][0];
+            lo[c] = xc[ends[c][0]];
+            std::int64_t hi = 0;
+            for (std::size_t s = 0; s < n; ++s) {
+                qc[s] = cell_coordinate((xc[s] - lo[c]) / cell_, std::size_t(id_[s])) + 1;
+                if (qc[s] > hi) {
+                    hi = qc[s];
+                    ends[c][1] = s;
+                }
+            }
+            dims[c] = hi + 2;
+        }
+        const double cells = double(dims[0]) * double(dims[1]) * double(dims[2]);
+        if (cells > 0x1p62) {
+            // Finite but runaway positions: name the end of the widest axis farther from the mean.
+            const int c = int(std::max_element(dims, dims + 3) - dims);
+            const T* xc = x_.data() + std::size_t(c) * n;
+            double mean = 0.0;
+            for (std::size_t s = 0; s < n; ++s) mean += double(xc[s]) / double(n);
+            const std::size_t far = std::abs(double(xc[ends[c][1]]) - mean) > std::abs(double(xc[ends[c][0]]) - mean) ? ends[c][1] : ends[c][0];
+            throw InstabilityError(fmt::format("particle {} has a runaway position (found by the fast variant's cell search)", id_[far]), -1,
+                                   std::int64_t(id_[far]));
+        }
+        dims_[0] = dims[0];
+        dims_[1] = dims[1];
+        const std::int64_t* q = cell3_.data();
+        for (std::size_t s = 0; s < n; ++s)
+            key_[s] = {std::uint64_t(q[s] + dims[0] * (q[n + s] + dims[1] * q[2 * n + s])), id_[s], Index(s)};
+        // A compact box (the usual case) gets a table of cell starts and a stable counting sort, O(N);
+        // a huge sparse box (the paper's literal 2 m box) a comparison sort and binary searches.
+        dense_ = cells <= double(8 * n + 4096);
+        if (dense_) {
+            const std::size_t nc = std::size_t(cells);
+            cstart_.assign(nc + 1, 0);
+            for (std::size_t s = 0; s < n; ++s) ++cstart_[key_[s].cell + 1];
+            for (std::size_t c = 0; c < nc; ++c) cstart_[c + 1] += cstart_[c];
+            keytmp_.resize(n);
+            for (std::size_t s = 0; s < n; ++s) keytmp_[std::size_t(cstart_[key_[s].cell]++)] = key_[s];
+            for (std::size_t c = nc; c > 0; --c) cstart_[c] = cstart_[c - 1];  // back to starts
+            cstart_[0] = 0;
+            key_.swap(keytmp_);
+        } else {
+            std::sort(key_.begin(), key_.end(), [](const Key& a, const Key& b) { return a.cell != b.cell ? a.cell < b.cell : a.id < b.id; });
+        }
+        permute();
+        list_pairs();
+        xref_ = x_;
+    }
+
+    struct Key {
+        std::uint64_t cell;
+        Index id, from;
+    };
+
+    // New storage order: slot s takes the particle that was at key_[s].from.
+    void permute()
+    {
+        const std::size_t n = n_;
+        for (auto* arr : {&x_, &v_, &a_, &b3_, &b4_, &b5_, &th_, &w_, &al_, &r3_, &r4_, &r5_}) {
+            std::vector<T>& a = *arr;
+            T* dst = tmp_.data();
+            const T* src = a.data();
+#pragma omp parallel for schedule(static) if (par_)
+            for (std::size_t s = 0; s < n; ++s) {
+                const std::size_t from = std::size_t(key_[s].from);
+                dst[s] = src[from];
+                dst[n + s] = src[n + from];
+                dst[2 * n + s] = src[2 * n + from];
+            }
+            a.swap(tmp_);
+        }
+        for (auto* arr : {&r_, &m_, &I_}) {
+            for (std::size_t s = 0; s < n; ++s) tmp1_[s] = (*arr)[std::size_t(key_[s].from)];
+            arr->swap(tmp1_);
+        }
+        for (std::size_t s = 0; s < n; ++s) {
+            id_[s] = key_[s].id;
+            pos_[std::size_t(key_[s].id)] = Index(s);
+        }
+    }
+
+    // Calls f(q) for every particle q in the 27 cells around s's cell (s itself included).
+    template <class F>
+    void for_each_near(std::size_t s, F&& f) const
+    {
+        const std::uint64_t k = key_[s].cell;
+        const auto dx = std::uint64_t(dims_[0]), dxy = dx * std::uint64_t(dims_[1]);
+        auto below = [](const Key& e, std::uint64_t v) { return e.cell < v; };
+        for (int dz = -1; dz <= 1; ++dz)
+            for (int dy = -1; dy <= 1; ++dy) {
+                const std::uint64_t row = k + std::uint64_t(std::int64_t(dz) * std::int64_t(dxy) + std::int64_t(dy) * std::int64_t(dx));
+                if (dense_) {
+                    for (Index t = cstart_[row - 1]; t < cstart_[row + 2]; ++t) f(std::size_t(t));
+                    continue;
+                }
+                const auto b = std::lower_bound(key_.begin(), key_.end(), row - 1, below);
+                const auto e = std::lower_bound(b, key_.end(), row + 2, below);
+                for (auto it = b; it != e; ++it) f(std::size_t(it - key_.begin()));
+            }
+    }
+
+    void list_pairs()
+    {
+        const std::size_t n = n_;
+        const T half_skin = skin_ * T(0.5);
+        // may_touch with each radius grown by skin/2: pairs closer than R_i + R_j + skin, with the law's margin.
+        auto near = [&](std::size_t s, std::size_t q) {
+            return id_[q] > id_[s] && may_touch(get(x_, s), get(x_, q), r_[s] + half_skin, r_[q] + half_skin);
+        };
+        Index* pstart = pstart_.data();
+#pragma omp parallel for schedule(static) if (par_)
+        for (std::size_t s = 0; s < n; ++s) {
+            Index c = 0;
+            for_each_near(s, [&](std::size_t q) { c += Index(near(s, q)); });
+            pstart[s + 1] = c;
+        }
+        pstart[0] = 0;
+        for (std::size_t s = 0; s < n; ++s) pstart[s + 1] += pstart[s];
+        const std::size_t total = std::size_t(pstart[n]);
+        partner_.resize(total);
+        owner_.resize(total);
+        slot_.resize(total);
+        Index* partner = partner_.data();
+        Index* owner = owner_.data();
+        const bool canonical = opt_.canonical;
+#pragma omp parallel for schedule(static) if (par_)
+        for (std::size_t s = 0; s < n; ++s) {
+            Index k = pstart[s];
+            for_each_near(s, [&](std::size_t q) {
+                if (!near(s, q)) return;
+                partner[k] = Index(q);
+                owner[k] = Index(s);
+                ++k;
+            });
+            // Canonical: partners by ascending id. Unordered: the scan's order (ascending storage).
+            if (canonical)
+                std::sort(partner + pstart[s], partner + pstart[s + 1], [this](Index a, Index b) { return id_[a] < id_[b]; });
+        }
+        if (!canonical) return;
+        // The slots where each particle is the partner, by ascending id of the owner.
+        Index* lstart = lstart_.data();
+        std::fill(lstart_.begin(), lstart_.end(), 0);
+        for (std::size_t k = 0; k < total; ++k) ++lstart[std::size_t(partner[k]) + 1];
+        for (std::size_t s = 0; s < n; ++s) lstart[s + 1] += lstart[s];
+        lslot_.resize(total);
+        Index* lslot = lslot_.data();
+        for (std::size_t s = 0; s < n; ++s) tmpi_[s] = lstart[s];
+        for (std::size_t k = 0; k < total; ++k) lslot[tmpi_[std::size_t(partner[k])]++] = Index(k);
+#pragma omp parallel for schedule(static) if (par_)
+        for (std::size_t s = 0; s < n; ++s)
+            std::sort(lslot + lstart[s], lslot + lstart[s + 1], [&](Index a, Index b) { return id_[owner[a]] < id_[owner[b]]; });
+    }
+
+    FastOptions opt_;
+    bool par_ = true;
+    std::size_t n_ = 0, nw_ = 0;
+    std::int64_t step_ = 0, rebuilds_ = 0;
+    double dt_ = 0.0;
+    T skin_ = T(0), cell_ = T(0);
+    GearCoefficients<T> gear_;
+    ContactParams<T> params_;
+    Vec3<T> g_;
+    std::vector<Wall> walls_;
+    // Particles in storage (cell) order; id_[s] is the id at slot s, pos_[id] the slot of an id.
+    std::vector<T> x_, v_, a_, b3_, b4_, b5_, th_, w_, al_, r3_, r4_, r5_;  // (3N): x block, y block, z block
+    std::vector<T> f_, t_, acc_, alc_, xref_, tmp_;                          // (3N)
+    std::vector<T> r_, m_, I_, tmp1_;                                        // (N)
+    std::vector<Index> id_, pos_, tmpi_;                                     // (N)
+    std::vector<T> wp_, wn_, wv_;                                            // (walls, 3)
+    // The neighbour list: pairs of s in [pstart[s], pstart[s+1]), one slot each; where s is the partner.
+    std::vector<Index> pstart_, partner_, owner_, lstart_, lslot_;
+    std::vector<Slot<T>> slot_;
+    std::vector<Key> key_, keytmp_;
+    std::vector<std::int64_t> cell3_;  // (3N) cell coordinates at the last rebuild
+    std::vector<Index> cstart_;        // first storage slot of each cell (dense grid), cells + 1
+    bool dense_ = true;
+    std::int64_t dims_[2] = {0, 0};
+    std::vector<std::vector<Foreign<T>>> foreign_;  // per thread (unordered mode)
+    std::int64_t pp_ = 0, pw_ = 0;
+};
+
+} // namespace
+
+std::unique_ptr<FastVariant> make_fast_variant(const FastOptions& options) { return std::make_unique<Fast<double, FullModel>>(options); }
+
+void register_variant_fast(Registry& r)
+{
+    r.add({"fast", "data-oriented SoA in cell order, skin neighbour list, OpenMP; canonical order, bit-identical to arrays",
+           [] { return make_fast_variant(FastOptions{}); }, true, true});
+    VariantInfo u{"fast_unordered", "fast without the canonical order: plain accumulation (not bit-identical to arrays)",
+                  [] { return make_fast_variant(FastOptions{0.1, false}); }};
+    u.bitwise = false;
+    u.threaded = true;
+    r.add(std::move(u));
+}
+
+} // namespace demmat
