@@ -33,7 +33,7 @@ def main(argv):
             continue
         count, fn = int(m.group(1).replace(",", "")), m.group(2)
         for p, pat in PATTERNS.items():
-            if re.search(pat + r"(\s|$|\[)", fn):
+            if re.search(pat, fn):
                 best[p] = max(best[p], count)
     missing = [p for p, c in best.items() if c == 0]
     if missing:

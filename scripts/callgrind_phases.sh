@@ -12,6 +12,6 @@ for v in "$@"; do
   OMP_NUM_THREADS=1 valgrind --tool=callgrind --callgrind-out-file="$tmp/cg.$v" \
     "$build/app/demmat" run "$scene" --variant "$v" --steps "$steps" --quiet --json "$tmp/run.$v.json" >/dev/null 2>"$tmp/log.$v" ||
     { cat "$tmp/log.$v" >&2; exit 1; }
-  callgrind_annotate --inclusive=yes "$tmp/cg.$v" >"$tmp/annotate.$v.txt"
+  callgrind_annotate --inclusive=yes --threshold=100 "$tmp/cg.$v" >"$tmp/annotate.$v.txt"
   /usr/bin/python3 analysis/callgrind_phases.py "$tmp/annotate.$v.txt" "$tmp/run.$v.json" --steps "$steps" -o "$out/callgrind_$v.json"
 done

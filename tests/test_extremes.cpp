@@ -300,7 +300,9 @@ TEST_P(Extremes, OverdampedContactGainsNoEnergyAndDoesNotStick)
         last = e;
         ASSERT_LE(sn.force[0].x, 0.0) << "attraction at step " << k + 1;  // the force on 0 points away from 1
         if (h > 0 && prev_h > 0 && h < prev_h) past_max = true;
-        if (past_max) ASSERT_LE(h, prev_h) << "the pair approached again at step " << k + 1;
+        if (past_max) {
+            ASSERT_LE(h, prev_h) << "the pair approached again at step " << k + 1;
+        }
         hmax = std::max(hmax, h);
         prev_h = h;
     }
