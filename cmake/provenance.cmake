@@ -4,7 +4,8 @@ execute_process(COMMAND git -C ${SRC} rev-parse HEAD OUTPUT_VARIABLE commit OUTP
 if(NOT rc EQUAL 0 OR commit STREQUAL "")
   set(commit "unknown")
 endif()
-execute_process(COMMAND git -C ${SRC} status --porcelain --untracked-files=no OUTPUT_VARIABLE status ERROR_QUIET RESULT_VARIABLE rc)
+# results/ is what the code writes, not what it is built from: a run that rewrites it leaves the build clean.
+execute_process(COMMAND git -C ${SRC} status --porcelain --untracked-files=no -- . ":(exclude)results" OUTPUT_VARIABLE status ERROR_QUIET RESULT_VARIABLE rc)
 if(rc EQUAL 0 AND status STREQUAL "")
   set(dirty "false")
 else()
