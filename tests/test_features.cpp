@@ -203,8 +203,9 @@ TEST(ModelChoice, EveryCommittedSceneGetsTheExpectedModel)
             auto v = registry().find(name).create();
             v->init(setup);
             EXPECT_TRUE(v->model().covers(need)) << name << " on " << file << " runs " << v->model().name();
-            if (std::find(kSpecialising.begin(), kSpecialising.end(), name) != kSpecialising.end())
+            if (std::find(kSpecialising.begin(), kSpecialising.end(), name) != kSpecialising.end()) {
                 EXPECT_EQ(v->model(), with_model(need, []<class M>() { return ModelFeatures::of<M>(); })) << name << " on " << file;
+            }
         }
         ++seen;
     }

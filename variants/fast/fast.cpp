@@ -258,24 +258,75 @@ private:
         }
     }
 
-    // The contact of slot k (owner s, partner q; id(s) < id(q)), or zeros. Zeros add nothing: a sum that
-    // starts at +0 is never -0, and x + ±0 = x for every other x, so adding a rejected slot's zeros
-    // leaves the bits of arrays, which skips it.
-    bool pair(std::size_t s, std::size_t q, Slot<T>& out) const
+    // The law runs on packs of kLanes candidates (the widest vector the target has); the slots are
+    // shared out among the threads in blocks of kBlock.
+    using Lanes = Pack<T, native_lanes<T>>;
+    static constexpr int kLanes = native_lanes<T>;
+    static constexpr std::size_t kBlock = 512;
+
+    // Slots [k0, k1) (owner s, partner q; id(s) < id(q)): each gets its contact, or zeros. Zeros add
+    // nothing: a sum that starts at +0 is never -0, and x + ±0 = x for every other x, so adding a
+    // rejected slot's zeros leaves the bits of arrays, which skips it. may_touch first, a cheap and
+    // conservative test (the law rejects every pair it rejects), so the skin's extra candidates cost a
+    // distance, not a pass through the law; the rest go through the law kLanes at a time. Returns the
+    // contacts found.
+    std::int64_t slots_of(std::size_t k0, std::size_t k1)
     {
-        const Vec3<T> xs = get(x_, s), xq = get(x_, q);
-        ContactForce<T> c;
-        // may_touch first: a cheap, conservative test (the law rejects every pair it rejects), so the
-        // skin's extra candidates cost a distance, not a square root.
-        if (may_touch(xs, xq, r_[s], r_[q]) &&
-            particle_contact<M>(xs, xq, get(v_, s), get(v_, q), get(w_, s), get(w_, q), r_[s], r_[q], m_[s], m_[q], params_, c)) {
-            out.f = c.f_i;
-            out.ti = c.t_i;
-            out.tj = c.t_j;
-            return true;
+        const Index* owner = owner_.data();
+        const Index* partner = partner_.data();
+        std::size_t pending[kLanes];
+        int fill = 0;
+        std::int64_t found = 0;
+        for (std::size_t k = k0; k < k1; ++k) {
+            const std::size_t s = std::size_t(owner[k]), q = std::size_t(partner[k]);
+            if (!may_touch(get(x_, s), get(x_, q), r_[s], r_[q])) {
+                slot_[k] = Slot<T>{};
+                continue;
+            }
+            pending[fill++] = k;
+            if (fill == kLanes) {
+                found += pack_of_slots(pending, fill);
+                fill = 0;
+            }
         }
-        out = Slot<T>{};
-        return false;
+        if (fill > 0) found += pack_of_slots(pending, fill);
+        return found;
+    }
+
+    // The law for up to kLanes slots at once (unused lanes repeat the last slot and are not stored):
+    // gather both particles of each slot into the lanes, run particle_contact_lanes, scatter the lanes
+    // back into the slots. Each lane's bits are those particle_contact gives for its slot's pair.
+    int pack_of_slots(const std::size_t* ks, int count)
+    {
+        static_assert(M::polydisperse, "the lanes get no monodisperse coefficients");
+        Vec3<Lanes> xi, xj, vi, vj, wi, wj;
+        Lanes ri{}, rj{}, mi{}, mj{};
+        const std::size_t n = n_;
+        for (int l = 0; l < kLanes; ++l) {
+            const std::size_t k = ks[l < count ? l : count - 1];
+            const std::size_t s = std::size_t(owner_[k]), q = std::size_t(partner_[k]);
+            xi.x[l] = x_[s]; xi.y[l] = x_[n + s]; xi.z[l] = x_[2 * n + s];
+            xj.x[l] = x_[q]; xj.y[l] = x_[n + q]; xj.z[l] = x_[2 * n + q];
+            vi.x[l] = v_[s]; vi.y[l] = v_[n + s]; vi.z[l] = v_[2 * n + s];
+            vj.x[l] = v_[q]; vj.y[l] = v_[n + q]; vj.z[l] = v_[2 * n + q];
+            wi.x[l] = w_[s]; wi.y[l] = w_[n + s]; wi.z[l] = w_[2 * n + s];
+            wj.x[l] = w_[q]; wj.y[l] = w_[n + q]; wj.z[l] = w_[2 * n + q];
+            ri[l] = r_[s]; rj[l] = r_[q];
+            mi[l] = m_[s]; mj[l] = m_[q];
+        }
+        ContactForce<Lanes> c;
+        const auto touch = particle_contact_lanes<M>(xi, xj, vi, vj, wi, wj, ri, rj, mi, mj, params_, Coefficients<Lanes>{}, c);
+        int found = 0;
+        for (int l = 0; l < count; ++l) {
+            Slot<T>& out = slot_[ks[l]];
+            out.f = {c.f_i.x[l], c.f_i.y[l], c.f_i.z[l]};
+            if constexpr (M::rotation) {
+                out.ti = {c.t_i.x[l], c.t_i.y[l], c.t_i.z[l]};
+                out.tj = {c.t_j.x[l], c.t_j.y[l], c.t_j.z[l]};
+            }
+            found += int(touch[l] != 0);
+        }
+        return found;
     }
 
     void forces_canonical()
@@ -283,16 +334,15 @@ private:
         const std::size_t n = n_;
         std::int64_t pp = 0, pw = 0;
         const Index* pstart = pstart_.data();
-        const Index* partner = partner_.data();
         const Index* lstart = lstart_.data();
         const Index* lslot = lslot_.data();
         Slot<T>* slot = slot_.data();
+        const std::size_t total = partner_.size(), blocks = (total + kBlock - 1) / kBlock;
 #pragma omp parallel if (par_)
         {
-            // Every contact once, into its slot.
+            // Every contact once, into its slot, a pack of candidates at a time.
 #pragma omp for schedule(static) reduction(+ : pp)
-            for (std::size_t s = 0; s < n; ++s)
-                for (Index k = pstart[s]; k < pstart[s + 1]; ++k) pp += pair(s, std::size_t(partner[k]), slot[k]);
+            for (std::size_t b = 0; b < blocks; ++b) pp += slots_of(b * kBlock, std::min(total, (b + 1) * kBlock));
             // Each particle's sum in the canonical order: as j (partners of lower id, ascending), as i
             // (partners of higher id, ascending), its walls in wall order; then Newton.
 #pragma omp for schedule(static) reduction(+ : pw)
@@ -367,14 +417,14 @@ private:
             }
             std::vector<Foreign<T>>& queue = foreign_[t];
             queue.clear();
+            // The contacts of this thread's particles, a pack at a time, then added up as they come.
+            pp += slots_of(std::size_t(pstart_[lo]), std::size_t(pstart_[hi]));
 #pragma omp barrier
             for (std::size_t s = lo; s < hi; ++s) {
                 Vec3<T> F{}, Tq{};
                 for (Index k = pstart_[s]; k < pstart_[s + 1]; ++k) {
                     const std::size_t q = std::size_t(partner_[k]);
-                    Slot<T> c;
-                    if (!pair(s, q, c)) continue;
-                    ++pp;
+                    const Slot<T>& c = slot_[std::size_t(k)];
                     F += c.f;
                     if constexpr (M::rotation) Tq += c.ti;
                     if (q >= lo && q < hi) {

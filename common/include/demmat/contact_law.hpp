@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "demmat/lanes.hpp"
 #include "demmat/model.hpp"
 #include "demmat/vec3.hpp"
 
@@ -60,23 +61,24 @@ inline bool may_touch_wall(const Vec3<T>& xi, T ri, const Vec3<T>& point, const 
 // cn = γ_n·m* multiplies u_n, ct = γ_t·m* multiplies |u_t|. A pair enters the law only through R* and m*,
 // so a polydisperse model computes these per contact and a monodisperse one once per run, for the one
 // radius and mass (pair_coefficients / wall_coefficients): the same operations, hence the same bits.
+// T is a scalar or a pack of lanes (lanes.hpp); S, the parameters' type, is T's scalar.
 template <class T>
 struct Coefficients {
     T kn{}, cn{}, ct{};
 };
 
-template <class T>
-inline Coefficients<T> coefficients(T hertz, T rstar, T mstar, const ContactParams<T>& p)
+template <class T, class S>
+inline Coefficients<T> coefficients(S hertz, T rstar, T mstar, const ContactParams<S>& p)
 {
-    return {hertz * std::sqrt(rstar), p.gamma_n * mstar, p.gamma_t * mstar};
+    return {hertz * lane_sqrt(rstar), p.gamma_n * mstar, p.gamma_t * mstar};
 }
-template <class T>
-inline Coefficients<T> pair_coefficients(T ri, T rj, T mi, T mj, const ContactParams<T>& p)
+template <class T, class S>
+inline Coefficients<T> pair_coefficients(T ri, T rj, T mi, T mj, const ContactParams<S>& p)
 {
     return coefficients(p.hertz_pp, ri * rj / (ri + rj), mi * mj / (mi + mj), p);
 }
-template <class T>
-inline Coefficients<T> wall_coefficients(T ri, T mi, const ContactParams<T>& p)
+template <class T, class S>
+inline Coefficients<T> wall_coefficients(T ri, T mi, const ContactParams<S>& p)
 {
     return coefficients(p.hertz_pw, ri, mi, p);  // R* = R_i, m* = m_i
 }
@@ -84,28 +86,60 @@ inline Coefficients<T> wall_coefficients(T ri, T mi, const ContactParams<T>& p)
 namespace detail {
 
 // Normal and tangential force from the contact geometry (n from i towards the partner, overlap h > 0,
-// relative velocity u of i with respect to the partner at the contact point).
-template <class M, class T>
-inline void contact_force(const Vec3<T>& n, T h, const Vec3<T>& u, const Coefficients<T>& k, const ContactParams<T>& p,
+// relative velocity u of i with respect to the partner at the contact point). The two branches of the
+// law (the clip and a zero tangential speed) are selects, so a pack of lanes runs the same code.
+template <class M, class T, class S>
+inline void contact_force(const Vec3<T>& n, T h, const Vec3<T>& u, const Coefficients<T>& k, const ContactParams<S>& p,
                           Vec3<T>& f_i, Vec3<T>& f_t)
 {
+    const T zero{};
     // h^(3/2) as h·sqrt(h): sqrt is correctly rounded in every language, pow is not (physics.md §6).
     // kn·h·sqrt(h) is (4/3)E*·sqrt(R*)·h·sqrt(h) evaluated left to right, as the ports write it.
-    T fn = k.kn * h * std::sqrt(h);
+    T fn = k.kn * h * lane_sqrt(h);
     T un{};
     if constexpr (M::damping || M::friction) un = dot(u, n);
     if constexpr (M::damping) fn = fn + k.cn * un;
-    if (fn < T(0)) fn = T(0);  // choice: no attraction at the end of a contact
+    fn = fn < zero ? zero : fn;  // choice: no attraction at the end of a contact
     f_t = Vec3<T>{};
     if constexpr (M::friction) {
         const Vec3<T> ut = u - un * n;
-        const T ut_abs = std::sqrt(dot(ut, ut));
-        if (ut_abs > T(0)) {
-            const T ft = std::min(p.mu * fn, k.ct * ut_abs);
-            f_t = (-ft) * (ut / ut_abs);
-        }
+        const T ut_abs = lane_sqrt(dot(ut, ut));
+        // No tangential force without tangential motion; the divisor 1 there keeps a lane finite.
+        const auto sliding = ut_abs > zero;
+        const T ft = lane_min(p.mu * fn, k.ct * ut_abs);
+        const Vec3<T> t = (-ft) * (ut / (sliding ? ut_abs : splat<T>(S(1))));
+        f_t = {sliding ? t.x : zero, sliding ? t.y : zero, sliding ? t.z : zero};
     }
     f_i = (-fn) * n + f_t;
+}
+
+// The centre-to-centre vector, its length and the overlap h = R_i + R_j − d of a pair.
+template <class T>
+inline T pair_overlap(const Vec3<T>& xi, const Vec3<T>& xj, T ri, T rj, Vec3<T>& dx, T& d)
+{
+    dx = xj - xi;
+    d = lane_sqrt(dot(dx, dx));
+    return ri + rj - d;
+}
+
+// The particle–particle law once the overlap h > 0 is known (in every lane whose result is kept).
+template <class M, class T, class S>
+inline void pair_law(const Vec3<T>& dx, T d, T h, const Vec3<T>& vi, const Vec3<T>& vj, const Vec3<T>& wi, const Vec3<T>& wj,
+                     T ri, T rj, T mi, T mj, const ContactParams<S>& p, const Coefficients<T>& mono, ContactForce<T>& out)
+{
+    const Vec3<T> n = dx / d;
+    const Vec3<T> di = (ri - h * S(0.5)) * n;
+    const Vec3<T> dj = -((rj - h * S(0.5)) * n);
+    Vec3<T> u = vi - vj;
+    if constexpr (M::rotation) u = u + cross(wi, di) - cross(wj, dj);
+    Vec3<T> ft;
+    if constexpr (M::polydisperse) contact_force<M>(n, h, u, pair_coefficients(ri, rj, mi, mj, p), p, out.f_i, ft);
+    else contact_force<M>(n, h, u, mono, p, out.f_i, ft);
+    if constexpr (M::rotation) {
+        out.t_i = cross(di, ft);
+        out.t_j = cross(dj, -ft);
+    }
+    out.overlap = h;
 }
 
 } // namespace detail
@@ -118,23 +152,11 @@ inline bool particle_contact(const Vec3<T>& xi, const Vec3<T>& xj, const Vec3<T>
                              const Vec3<T>& wi, const Vec3<T>& wj, T ri, T rj, T mi, T mj,
                              const ContactParams<T>& p, const Coefficients<T>& mono, ContactForce<T>& out)
 {
-    const Vec3<T> dx = xj - xi;
-    const T d = std::sqrt(dot(dx, dx));
-    const T h = ri + rj - d;
+    Vec3<T> dx;
+    T d;
+    const T h = detail::pair_overlap(xi, xj, ri, rj, dx, d);
     if (!(h > T(0))) return false;
-    const Vec3<T> n = dx / d;
-    const Vec3<T> di = (ri - h * T(0.5)) * n;
-    const Vec3<T> dj = -((rj - h * T(0.5)) * n);
-    Vec3<T> u = vi - vj;
-    if constexpr (M::rotation) u = u + cross(wi, di) - cross(wj, dj);
-    Vec3<T> ft;
-    if constexpr (M::polydisperse) detail::contact_force<M>(n, h, u, pair_coefficients(ri, rj, mi, mj, p), p, out.f_i, ft);
-    else detail::contact_force<M>(n, h, u, mono, p, out.f_i, ft);
-    if constexpr (M::rotation) {
-        out.t_i = cross(di, ft);
-        out.t_j = cross(dj, -ft);
-    }
-    out.overlap = h;
+    detail::pair_law<M>(dx, d, h, vi, vj, wi, wj, ri, rj, mi, mj, p, mono, out);
     return true;
 }
 
@@ -146,6 +168,28 @@ inline bool particle_contact(const Vec3<T>& xi, const Vec3<T>& xj, const Vec3<T>
 {
     static_assert(M::polydisperse, "a monodisperse model needs the run's pair coefficients");
     return particle_contact<M>(xi, xj, vi, vj, wi, wj, ri, rj, mi, mj, p, Coefficients<T>{}, out);
+}
+
+// W pairs at once, one per lane of the pack V (lanes.hpp): the same law, operation for operation, so
+// each lane holds the bits particle_contact gives for its pair. Returns the lanes in contact (h > 0);
+// the others hold zeros in f_i, t_i and t_j, which add nothing to a sum (see the fast variant).
+template <class M, LanePack V>
+inline auto particle_contact_lanes(const Vec3<V>& xi, const Vec3<V>& xj, const Vec3<V>& vi, const Vec3<V>& vj,
+                                   const Vec3<V>& wi, const Vec3<V>& wj, V ri, V rj, V mi, V mj,
+                                   const ContactParams<LaneScalar<V>>& p, const Coefficients<V>& mono, ContactForce<V>& out)
+{
+    Vec3<V> dx;
+    V d;
+    const V h = detail::pair_overlap(xi, xj, ri, rj, dx, d);
+    const auto touch = h > V{};
+    detail::pair_law<M>(dx, d, h, vi, vj, wi, wj, ri, rj, mi, mj, p, mono, out);
+    auto keep = [&](Vec3<V>& a) { a = {touch ? a.x : V{}, touch ? a.y : V{}, touch ? a.z : V{}}; };
+    keep(out.f_i);
+    if constexpr (M::rotation) {
+        keep(out.t_i);
+        keep(out.t_j);
+    }
+    return touch;
 }
 
 // Particle–wall contact: the wall is a plane through `point` with unit normal `normal` pointing into

@@ -1,0 +1,93 @@
+#pragma once
+// Packs of lanes for the shared contact law (GCC and Clang vector extensions). The law is written once
+// on a value type T that is either a scalar or a pack of W scalars; for a pack, +, −, ×, ÷, comparisons
+// and lane_sqrt are the scalar IEEE operations applied lane by lane (correctly rounded, no fusion under
+// -ffp-contract=off), so every lane holds the bits the scalar law gives for that pair. Branches of the
+// law are written as selects, `cond ? a : b`, which C++ evaluates lane by lane for a pack.
+#include <cmath>
+#include <concepts>
+#include <cstddef>
+#include <type_traits>
+#include <utility>
+
+#if defined(__SSE2__)
+#include <immintrin.h>
+#endif
+
+namespace demmat {
+
+namespace detail {
+template <class T, int W>
+struct PackOf {
+    typedef T type __attribute__((vector_size(W * sizeof(T))));
+};
+} // namespace detail
+
+// W values of T in one vector register (or in several, where W is wider than the machine's vectors).
+template <class T, int W>
+using Pack = typename detail::PackOf<T, W>::type;
+
+// The widest vector the compilation target has (AVX-512, AVX, else SSE2's 16 bytes), in lanes of T.
+template <class T>
+inline constexpr int native_lanes =
+#if defined(__AVX512F__)
+    int(64 / sizeof(T));
+#elif defined(__AVX__)
+    int(32 / sizeof(T));
+#else
+    int(16 / sizeof(T));
+#endif
+
+template <class V>
+concept LanePack = requires(V v) { v[0]; } && std::is_trivially_copyable_v<V> && !std::is_arithmetic_v<V>;
+
+template <LanePack V>
+using LaneScalar = std::remove_cvref_t<decltype(std::declval<V&>()[0])>;
+
+template <LanePack V>
+inline constexpr int lane_count = int(sizeof(V) / sizeof(LaneScalar<V>));
+
+inline double lane_sqrt(double a) { return std::sqrt(a); }
+inline float lane_sqrt(float a) { return std::sqrt(a); }
+
+template <LanePack V>
+inline V lane_sqrt(V a)
+{
+    using S = LaneScalar<V>;
+    // The packed square roots are IEEE's correctly rounded sqrt, as sqrtsd / sqrtss are.
+#if defined(__AVX512F__)
+    // (The masked forms, all lanes selected: GCC 12 warns about the unmasked ones' undefined source.)
+    if constexpr (sizeof(V) == 64 && std::same_as<S, double>) return (V)_mm512_mask_sqrt_pd((__m512d)a, __mmask8(0xff), (__m512d)a);
+    if constexpr (sizeof(V) == 64 && std::same_as<S, float>) return (V)_mm512_mask_sqrt_ps((__m512)a, __mmask16(0xffff), (__m512)a);
+#endif
+#if defined(__AVX__)
+    if constexpr (sizeof(V) == 32 && std::same_as<S, double>) return (V)_mm256_sqrt_pd((__m256d)a);
+    if constexpr (sizeof(V) == 32 && std::same_as<S, float>) return (V)_mm256_sqrt_ps((__m256)a);
+#endif
+#if defined(__SSE2__)
+    if constexpr (sizeof(V) == 16 && std::same_as<S, double>) return (V)_mm_sqrt_pd((__m128d)a);
+    if constexpr (sizeof(V) == 16 && std::same_as<S, float>) return (V)_mm_sqrt_ps((__m128)a);
+#endif
+    V r{};
+    for (int l = 0; l < lane_count<V>; ++l) r[l] = std::sqrt(a[l]);
+    return r;
+}
+
+// std::min's definition, (b < a) ? b : a, for scalars and lane by lane for packs.
+template <class T>
+inline T lane_min(T a, T b) { return b < a ? b : a; }
+
+// Every lane s (a pack built from a scalar), or s itself for a scalar type.
+template <class V, class S>
+inline V splat(S s)
+{
+    if constexpr (std::is_arithmetic_v<V>) {
+        return V(s);
+    } else {
+        V r{};
+        for (int l = 0; l < lane_count<V>; ++l) r[l] = s;
+        return r;
+    }
+}
+
+} // namespace demmat
