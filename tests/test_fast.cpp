@@ -90,10 +90,12 @@ TEST(Fast, DenseBedIsBitIdenticalToArraysAtOneAndTwoThreads)
 
 TEST(Fast, CompressionStageIsBitIdenticalToArraysWhileTheListIsRebuilt)
 {
-    // Grains still falling and the wall moving in: with the default skin (0.1·R_max = 0.5 mm) the list
-    // is rebuilt, and the particles re-sorted, every ten to twenty steps.
+    // Grains still falling and the wall moving in: with a skin of 0.1·R_max (0.5 mm) the list is
+    // rebuilt, and the particles re-sorted, every ten to twenty steps.
     Case c = bed_case(0.5);
-    const auto r = lockstep(c.setup, 3000, {{FastOptions{}, 1}, {FastOptions{}, 2}});
+    FastOptions thin;
+    thin.skin = 0.1;
+    const auto r = lockstep(c.setup, 3000, {{thin, 1}, {thin, 2}});
     EXPECT_EQ(r.difference, "");
     ASSERT_EQ(r.rebuilds.size(), 2u);
     EXPECT_GE(r.rebuilds[0], 20) << "the displacement check never asked for a rebuild";

@@ -661,7 +661,11 @@ void register_variant_fast(Registry& r)
     r.add({"fast", "data-oriented SoA in cell order, skin neighbour list, OpenMP; canonical order, bit-identical to arrays",
            [] { return make_fast_variant(FastOptions{}); }, true, true});
     VariantInfo u{"fast_unordered", "fast without the canonical order: plain accumulation (not bit-identical to arrays)",
-                  [] { return make_fast_variant(FastOptions{0.1, false}); }};
+                  [] {
+                      FastOptions unordered;  // the default skin, so that only the order differs
+                      unordered.canonical = false;
+                      return make_fast_variant(unordered);
+                  }};
     u.bitwise = false;
     u.threaded = true;
     r.add(std::move(u));
