@@ -3,7 +3,8 @@
 # (0.4 s simulated with fast on every core, kept in states/), then `demmat bench` of arrays, fast and
 # fast_unordered on the settled bed (walls at rest) at each thread count, interleaved repetitions,
 # medians; then 10^6 particles run a few steps to show they fit (peak memory from /usr/bin/time).
-# Writes results/fast/bench_settled_<N>_t<threads>.json (+ .txt) and results/fast/million.txt.
+# Writes results/fast/bench_settled_<N>_t<threads>.json (+ .txt), results/fast/million.txt and the table
+# results/fast/summary.md (analysis/summarise_fast.py).
 # Usage: scripts/bench_fast.sh [--sizes "1000 10000 100000"] [--threads "1 2"] [--repetitions R]
 #                              [--settle-time T] [--no-million] [--build DIR]
 # Timed steps per repetition are 5·10^6/N (at least 20), so each sample is ~10^6–10^7 particle-steps.
@@ -59,4 +60,5 @@ if [[ $million == 1 ]]; then
   grep -E "Maximum resident|Elapsed" results/fast/million_time.txt | tee -a results/fast/million.txt
   cat results/fast/million.txt
 fi
-echo "results in results/fast/"
+/usr/bin/python3 analysis/summarise_fast.py results/fast -o results/fast/summary.md >/dev/null
+echo "results in results/fast/ (table: results/fast/summary.md)"
