@@ -271,7 +271,10 @@ def where(df, prov, callgrind, out, figs, suffix):
         atomic_write(os.path.join(out, "stream.csv"), lambda tmp: s.to_csv(tmp, index=False, float_format="%.6g"))
     cols = ["predict_s", "correct_s", "search_s", "forces_s", "total_s", "forces_ns_per_contact", "forces_ns_per_candidate",
             "search_ns_per_candidate", "contacts_per_particle", "candidates_per_particle"]
-    m = med(ph[ph.state == "settled"] if "settled" in set(ph.state) else ph, ["variant", "threads", "particles"], cols)
+    # The settled bed where the run has it; otherwise what it has (a slice of the sweep, e.g. the 10⁶ loose grid).
+    state = "settled" if "settled" in set(ph.state) else sorted(set(ph.state))[0]
+    state_name = {"settled": "settled bed", "loose": "loose grid", "compression": "compression stage"}.get(state, state)
+    m = med(ph[ph.state == state], ["variant", "threads", "particles"], cols)
     bitwise = ph.groupby("variant")["bitwise"].first() if "bitwise" in ph else None
     # The fastest bit-identical variant at the largest N, one thread.
     one = m[(m.threads == 1)]
@@ -279,7 +282,7 @@ def where(df, prov, callgrind, out, figs, suffix):
         one = one[one.variant.map(lambda v: bool(bitwise.get(v, True)))]
     nmax = one.particles.max()
     fastest = one[one.particles == nmax].sort_values("total_s").iloc[0].variant
-    lines = [f"Where the time goes: **{fastest}** (the fastest bit-identical variant at N = {nmax}, one thread), settled bed. "
+    lines = [f"Where the time goes: **{fastest}** (the fastest bit-identical variant at N = {nmax}, one thread), {state_name}. "
              + caption(prov), "",
              "| N | threads | phase | ns per particle-step | bound from bandwidth (ns) | measured / bound | ns per contact | ns per candidate pair |",
              "|---|---|---|---|---|---|---|---|"]
@@ -292,7 +295,9 @@ def where(df, prov, callgrind, out, figs, suffix):
                 bound = GEAR_DOUBLES[p] * 8 / (best_bw * 1e9) * 1e9
                 lines.append(f"| {n} | {t} | {p} | {ns:.1f} | {bound:.1f} | {ns / bound:.2f} | | |")
             elif p == "forces":
-                lines.append(f"| {n} | {t} | {p} | {ns:.1f} | | | {r.forces_ns_per_contact:.1f} | {r.forces_ns_per_candidate:.1f} |")
+                # Per contact only where there are contacts to speak of (a loose grid has almost none).
+                per_contact = f"{r.forces_ns_per_contact:.1f}" if r.contacts_per_particle >= 0.1 else ""
+                lines.append(f"| {n} | {t} | {p} | {ns:.1f} | | | {per_contact} | {r.forces_ns_per_candidate:.1f} |")
             elif p == "search":
                 lines.append(f"| {n} | {t} | {p} | {ns:.1f} | | | | {r.search_ns_per_candidate:.1f} |")
             else:
@@ -328,7 +333,7 @@ def where(df, prov, callgrind, out, figs, suffix):
     ax.set_yscale("log")
     ax.set_xlabel("particles N")
     ax.set_ylabel("ns per particle-step")
-    ax.set_title(f"Where the time goes: {fastest}, settled bed", fontsize=10)
+    ax.set_title(f"Where the time goes: {fastest}, {state_name}", fontsize=10)
     ax.grid(which="both", alpha=0.3)
     ax.legend(fontsize=6.5, ncol=2)
     fig.text(0.01, 0.01, caption(prov), fontsize=5.5)
