@@ -1,5 +1,6 @@
 #pragma once
 // Shared helpers for the tests: scenes in memory, runs of a variant, and the list of variants.
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <string>
@@ -23,6 +24,17 @@ struct Case {
 };
 
 inline std::vector<std::string> variant_names() { return registry().names(); }
+
+// The length of a long equivalence run (thousands of contact-rich steps). The sanitizer build
+// (DEMMAT_SANITIZE) runs a third of it: it hunts memory errors and undefined behaviour, which the
+// first thousand steps of every path (list rebuilds, contacts made and broken) already exercise,
+// while the normal build checks the full trajectories bit for bit. This keeps CI within its time.
+#ifdef DEMMAT_SANITIZED
+inline constexpr std::int64_t kLongRunDivisor = 3;
+#else
+inline constexpr std::int64_t kLongRunDivisor = 1;
+#endif
+inline std::int64_t long_run(std::int64_t steps) { return steps / kLongRunDivisor; }
 
 // Runs `steps` steps of a variant and returns it with its driver.
 struct VariantRun {

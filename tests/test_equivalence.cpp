@@ -29,7 +29,7 @@ TEST_P(Equivalence, SearchMethodsGiveBitIdenticalTrajectories)
     // Without the canonical order the sums follow the storage order, which the cell size changes.
     if (!registry().find(GetParam()).bitwise) GTEST_SKIP() << "drops the canonical order on purpose (its physics is tested elsewhere)";
     // Cells of 2·R_max, 4·R_max and every pair: one trajectory, over thousands of contact-rich steps.
-    const std::int64_t steps = 3000;
+    const std::int64_t steps = long_run(3000);
     std::vector<Snapshot> finals;
     for (auto [method, cell] : {std::pair{SearchMethod::cells, 2.0}, {SearchMethod::cells, 4.0}, {SearchMethod::all_pairs, 2.0}}) {
         Scene s = dense_bed_scene(1000);
@@ -52,7 +52,7 @@ TEST_P(Equivalence, DenseBedIsBitIdenticalToArraysAtEveryStep)
     if (GetParam() == "arrays") GTEST_SKIP() << "the reference itself";
     if (!registry().find(GetParam()).bitwise) GTEST_SKIP() << "drops the canonical order on purpose (its physics is tested elsewhere)";
     Case c = bed_case(0.0);
-    EXPECT_EQ(compare({"arrays", GetParam()}, c.setup, 5000), "");
+    EXPECT_EQ(compare({"arrays", GetParam()}, c.setup, long_run(5000)), "");
 }
 
 TEST_P(Equivalence, CompressionStageIsBitIdenticalToArraysAtEveryStep)
@@ -60,7 +60,7 @@ TEST_P(Equivalence, CompressionStageIsBitIdenticalToArraysAtEveryStep)
     if (GetParam() == "arrays") GTEST_SKIP() << "the reference itself";
     if (!registry().find(GetParam()).bitwise) GTEST_SKIP() << "drops the canonical order on purpose (its physics is tested elsewhere)";
     Case c = bed_case(0.5);
-    EXPECT_EQ(compare({"arrays", GetParam()}, c.setup, 3000), "");
+    EXPECT_EQ(compare({"arrays", GetParam()}, c.setup, long_run(3000)), "");
 }
 
 TEST_P(Equivalence, PaperSceneIsBitIdenticalToArrays)

@@ -83,7 +83,7 @@ TEST(Fast, DenseBedIsBitIdenticalToArraysAtOneAndTwoThreads)
 {
     Case c = bed_case(0.0);
     ASSERT_GE(c.state.size(), 2000u);
-    const auto r = lockstep(c.setup, 5000, {{FastOptions{}, 1}, {FastOptions{}, 2}});
+    const auto r = lockstep(c.setup, long_run(5000), {{FastOptions{}, 1}, {FastOptions{}, 2}});
     EXPECT_EQ(r.difference, "");
     EXPECT_GT(r.contacts, 3000);  // contact-rich: > 3 contacts per particle
 }
@@ -95,7 +95,7 @@ TEST(Fast, CompressionStageIsBitIdenticalToArraysWhileTheListIsRebuilt)
     Case c = bed_case(0.5);
     FastOptions thin;
     thin.skin = 0.1;
-    const auto r = lockstep(c.setup, 3000, {{thin, 1}, {thin, 2}});
+    const auto r = lockstep(c.setup, long_run(3000), {{thin, 1}, {thin, 2}});
     EXPECT_EQ(r.difference, "");
     ASSERT_EQ(r.rebuilds.size(), 2u);
     EXPECT_GE(r.rebuilds[0], 20) << "the displacement check never asked for a rebuild";
