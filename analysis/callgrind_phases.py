@@ -9,10 +9,10 @@ Usage: /usr/bin/python3 analysis/callgrind_phases.py ANNOTATE.txt RUN.json --ste
 """
 import argparse
 import json
-import os
 import re
 import sys
-import tempfile
+
+from atomic_io import write_text
 
 PATTERNS = {"predict": r"::predict\(long\)", "search": r"::search\(\)", "forces": r"::forces\(\)", "correct": r"::correct\(\)"}
 
@@ -44,12 +44,7 @@ def main(argv):
            "instructions_per_particle_step": {p: c / (n * a.steps) for p, c in best.items()},
            "contacts_per_particle": run["contacts"]["per_particle"], "provenance": run["provenance"],
            "tool": "valgrind --tool=callgrind; callgrind_annotate --inclusive=yes"}
-    d = os.path.dirname(os.path.abspath(a.out))
-    os.makedirs(d, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=d, suffix=".json")
-    with os.fdopen(fd, "w") as f:
-        json.dump(out, f, indent=1)
-    os.replace(tmp, a.out)
+    write_text(a.out, json.dumps(out, indent=1))
     print(f"{run['variant']}: " + ", ".join(f"{p} {v:.0f}" for p, v in out["instructions_per_particle_step"].items()) + " instructions per particle-step")
 
 

@@ -7,7 +7,6 @@ Usage: /usr/bin/python3 analysis/plot_accuracy.py results/accuracy/accuracy.json
 """
 import argparse
 import json
-import math
 import os
 
 import matplotlib

@@ -13,15 +13,15 @@ Usage: /usr/bin/python3 analysis/plot_features.py BENCH.json --figure OUT.png --
 """
 import argparse
 import json
-import os
 import sys
-import tempfile
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import pandas as pd  # noqa: E402
+
+from atomic_io import atomic_write, write_text  # noqa: E402
 
 PHASES = ["predict", "search", "forces", "correct"]
 # The GPU study of this group's code the issue quotes: over normal forces alone, history-dependent
@@ -144,20 +144,7 @@ def figure(t, path):
     axes[0][0].set_ylabel("ms per step (median; phases of the specialised run)")
     fig.legend(loc="upper center", ncol=5, fontsize=8, bbox_to_anchor=(0.5, 1.0))
     fig.tight_layout(rect=(0, 0, 1, 0.93))
-    write_atomically(path, lambda tmp: fig.savefig(tmp, dpi=130, format="png"))
-
-
-def write_atomically(path, write):
-    d = os.path.dirname(os.path.abspath(path))
-    os.makedirs(d, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=d, suffix=".tmp")
-    os.close(fd)
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
+    atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=130, format="png"))
 
 
 def main():
@@ -175,13 +162,9 @@ def main():
     t = table(samples(bench))
     ctx = bench.get("context", {})
     text = markdown(t, ctx)
-    def write_text(tmp):
-        with open(tmp, "w") as f:
-            f.write(text)
-
-    write_atomically(a.markdown, write_text)
+    write_text(a.markdown, text)
     if a.table:
-        write_atomically(a.table, lambda tmp: t.to_csv(tmp, index=False, float_format="%.6g"))
+        atomic_write(a.table, lambda tmp: t.to_csv(tmp, index=False, float_format="%.6g"))
     figure(t, a.figure)
     print(text)
 

@@ -21,7 +21,6 @@ import argparse
 import json
 import os
 import sys
-import tempfile
 
 import matplotlib
 
@@ -30,6 +29,8 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
+from atomic_io import atomic_write, write_text  # noqa: E402
+
 PHASES = ["predict", "search", "forces", "correct"]
 
 # Compulsory memory traffic of the 5th-order Gear scheme with rotation, per particle and step, in
@@ -37,23 +38,6 @@ PHASES = ["predict", "search", "forces", "correct"]
 # five (b5 is unchanged); the corrector reads the six and the new acceleration and writes six. Three
 # components, translation and rotation. A variant can move more (layout, write-allocate) but not less.
 GEAR_DOUBLES = {"predict": (6 + 5) * 3 * 2, "correct": (7 + 6) * 3 * 2}
-
-
-def atomic_write(path, write):
-    d = os.path.dirname(os.path.abspath(path))
-    os.makedirs(d, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=d, suffix=os.path.splitext(path)[1])
-    os.close(fd)
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
-
-
-def write_text(path, text):
-    atomic_write(path, lambda tmp: open(tmp, "w").write(text))
 
 
 def save_fig(fig, path):

@@ -11,13 +11,14 @@ import argparse
 import json
 import os
 import sys
-import tempfile
 
 import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import pandas as pd  # noqa: E402
+
+from atomic_io import atomic_write  # noqa: E402
 
 PHASES = ["predict", "search", "forces", "correct"]
 GROUPS = PHASES + ["search_plus_forces", "total"]
@@ -40,19 +41,6 @@ def table(tidy, order):
     stats["variant"] = pd.Categorical(stats["variant"], order)
     stats["phase"] = pd.Categorical(stats["phase"], GROUPS)
     return stats.sort_values(["variant", "phase"]).reset_index(drop=True)
-
-
-def atomic_write(path, write):
-    d = os.path.dirname(os.path.abspath(path))
-    os.makedirs(d, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(dir=d, suffix=os.path.splitext(path)[1])
-    os.close(fd)
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
 
 
 def caption(bench):

@@ -13,6 +13,8 @@ import sys
 
 import pandas as pd
 
+from atomic_io import write_text
+
 
 def load(folder):
     rows, prov = [], None
@@ -85,9 +87,7 @@ def main(argv):
         out.append(line + ".")
     text = "\n".join(out) + "\n"
     if a.output:
-        tmp = a.output.with_suffix(".tmp")
-        tmp.write_text(text)
-        tmp.replace(a.output)
+        write_text(str(a.output), text)
     print(text)
     return 0
 
