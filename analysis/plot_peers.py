@@ -25,15 +25,10 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
+from atomic_io import atomic_write, write_text  # noqa: E402
+
 STAGES = ["loose", "bed", "compression"]
 STAGE_TITLE = {"loose": "loose grid (t = 0)", "bed": "settled bed", "compression": "compression stage"}
-
-
-def write_atomically(path, text):
-    tmp = path + ".part"
-    with open(tmp, "w") as f:
-        f.write(text)
-    os.replace(tmp, path)
 
 
 # ---- bench ---------------------------------------------------------------------------------------------
@@ -61,12 +56,12 @@ def cmd_bench(a):
     versions = json.load(open(a.versions))
     os.makedirs(a.out, exist_ok=True)
     csv = os.path.join(a.out, "bench_peers.csv")
-    write_atomically(csv, med.to_csv(index=False, float_format="%.6g"))
+    write_text(csv, med.to_csv(index=False, float_format="%.6g"))
     out = {"provenance": provenance, "peers": versions, "timing": {
         "suite": "demmat bench: sum of the four timed phases per step (health checks excluded), median over its own run",
         "peers": "the code's own 'Loop time of' for the timed run after a warm-up run, divided by its steps"},
         "summary": med.to_dict("records"), "samples": df.to_dict("records")}
-    write_atomically(os.path.join(a.out, "bench_peers.json"), json.dumps(out, indent=1) + "\n")
+    write_text(os.path.join(a.out, "bench_peers.json"), json.dumps(out, indent=1) + "\n")
 
     # Figure: µs per particle-step against N, one panel per stage.
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.8), sharey=True)
@@ -90,12 +85,10 @@ def cmd_bench(a):
     fig.suptitle(f"One core each: the suite's variants, LAMMPS {versions.get('lammps', '')}, "
                  f"LIGGGHTS {versions.get('liggghts', '')} ({cpu})", fontsize=10)
     fig.tight_layout()
-    os.makedirs(os.path.dirname(a.figure), exist_ok=True)
-    fig.savefig(a.figure + ".part.png", dpi=110)
-    os.replace(a.figure + ".part.png", a.figure)
+    atomic_write(a.figure, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
 
     # Markdown: ratio to LAMMPS (same run), per stage and N.
-    lines = [f"# The suite beside LAMMPS and LIGGGHTS: time per step relative to LAMMPS",
+    lines = ["# The suite beside LAMMPS and LIGGGHTS: time per step relative to LAMMPS",
              "",
              f"Median of {int(med.repetitions.max())} interleaved repetitions, one core per code. "
              f"LAMMPS {versions.get('lammps', '?')} (Debian {versions.get('lammps_package', '?')}), "
@@ -118,7 +111,7 @@ def cmd_bench(a):
         lam_row = [m[(m.variant == 'lammps') & (m.particles == n)]["median"] for n in ns]
         lines.append("| *LAMMPS µs per particle-step* | " + " | ".join("" if r.empty else f"{r.iloc[0]:.3f}" for r in lam_row) + " |")
         lines.append("")
-    write_atomically(os.path.join(a.out, "bench_peers.md"), "\n".join(lines))
+    write_text(os.path.join(a.out, "bench_peers.md"), "\n".join(lines))
     print(f"results: {csv}, {os.path.join(a.out, 'bench_peers.json')}, {os.path.join(a.out, 'bench_peers.md')}, {a.figure}")
 
 
@@ -177,7 +170,7 @@ def cmd_observables(a):
         force = float(np.sum(np.maximum(fn, 0.0)))
         rows.append({"code": a.code, "member": a.member, "stage": a.stage, "step": step, "time": t,
                      "kinetic_energy": ke, "bed_height": height, "wall_force_x_max": force, "wall_contacts": int(on.sum())})
-    write_atomically(a.o, pd.DataFrame(rows).to_csv(index=False, float_format="%.9g"))
+    write_text(a.o, pd.DataFrame(rows).to_csv(index=False, float_format="%.9g"))
 
 
 # ---- physics -----------------------------------------------------------------------------------------------
@@ -211,14 +204,12 @@ def cmd_physics(a):
     axes[0, 0].legend(fontsize=8)
     fig.suptitle(f"{a.particles} grains, perturbed starts (velocity ±{a.amplitude} m/s): ensemble mean and min–max band per code", fontsize=10)
     fig.tight_layout()
-    os.makedirs(os.path.dirname(a.figure), exist_ok=True)
-    fig.savefig(a.figure + ".part.png", dpi=110)
-    os.replace(a.figure + ".part.png", a.figure)
+    atomic_write(a.figure, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
 
     # Summary: at a few times, each code's ensemble mean ± standard deviation, and the suite's and
     # LIGGGHTS's distance from LAMMPS in units of the pooled ensemble standard deviation.
     os.makedirs(a.out, exist_ok=True)
-    write_atomically(os.path.join(a.out, f"physics_{a.particles}.csv"), df.to_csv(index=False, float_format="%.9g"))
+    write_text(os.path.join(a.out, f"physics_{a.particles}.csv"), df.to_csv(index=False, float_format="%.9g"))
     lines = [f"# Physics cross-check: the suite, LAMMPS and LIGGGHTS from the same {a.particles} grains", "",
              f"Each code ran {df.member.nunique()} perturbed starts (velocities ± {a.amplitude} m/s, the same data files for "
              f"every code). Mean ± standard deviation over the ensemble; *z* = (code − LAMMPS) / pooled std. "
@@ -246,7 +237,7 @@ def cmd_physics(a):
                    if "suite" in mean.index and "lammps" in mean.index and mean["lammps"] != 0 else "")
             lines.append(f"| {t:.3f} | " + " | ".join(cells) + f" | {rel} | {z('suite')} | {z('liggghts')} |")
         lines.append("")
-    write_atomically(os.path.join(a.out, f"physics_{a.particles}.md"), "\n".join(lines))
+    write_text(os.path.join(a.out, f"physics_{a.particles}.md"), "\n".join(lines))
     print(f"results: {os.path.join(a.out, f'physics_{a.particles}.md')}, {a.figure}")
 
 
