@@ -425,6 +425,8 @@ private:
                 for (Index k = pstart_[s]; k < pstart_[s + 1]; ++k) {
                     const std::size_t q = std::size_t(partner_[k]);
                     const Slot<T>& c = slot_[std::size_t(k)];
+                    // A rejected candidate's zeros: nothing to add, and no write to the partner.
+                    if (c.f == Vec3<T>{} && (!M::rotation || (c.ti == Vec3<T>{} && c.tj == Vec3<T>{}))) continue;
                     F += c.f;
                     if constexpr (M::rotation) Tq += c.ti;
                     if (q >= lo && q < hi) {
