@@ -19,6 +19,7 @@
 #include "demmat/io.hpp"
 #include "demmat/output.hpp"
 #include "demmat/registry.hpp"
+#include "demmat/text.hpp"
 #include "demmat/scenes.hpp"
 #include "demmat/threads.hpp"
 #include "peer_commands.hpp"
@@ -63,17 +64,9 @@ std::vector<std::string> variant_list(const std::string& spec, bool allow_twice 
 {
     if (spec == "all") return registry().names();
     std::vector<std::string> out;
-    std::string cur;
-    for (char c : spec + ",") {
-        if (c == ',') {
-            if (!cur.empty()) {
-                if (!allow_twice && std::find(out.begin(), out.end(), cur) != out.end()) throw Error(fmt::format("variant '{}' is named twice", cur));
-                out.push_back(registry().find(cur).name);
-            }
-            cur.clear();
-        } else {
-            cur += c;
-        }
+    for (const std::string& name : split_list(spec)) {
+        if (!allow_twice && std::find(out.begin(), out.end(), name) != out.end()) throw Error(fmt::format("variant '{}' is named twice", name));
+        out.push_back(registry().find(name).name);
     }
     if (out.empty()) throw Error("no variant named in --variants");
     return out;

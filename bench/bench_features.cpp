@@ -38,6 +38,7 @@
 #include "demmat/features.hpp"
 #include "demmat/output.hpp"
 #include "demmat/registry.hpp"
+#include "demmat/text.hpp"
 #include "demmat/scenes.hpp"
 #include "demmat/state.hpp"
 
@@ -214,16 +215,8 @@ void parse_own_options(int& argc, char** argv)
             opt.states_dir = v;
         } else if (const char* v = value("--variants=")) {
             opt.variants.clear();
-            std::string cur;
-            for (const char* p = v;; ++p) {
-                if (*p == ',' || *p == '\0') {
-                    opt.variants.push_back(registry().find(cur).name);  // throws naming the known variants
-                    cur.clear();
-                    if (*p == '\0') break;
-                } else {
-                    cur += *p;
-                }
-            }
+            for (const std::string& name : split_list(v)) opt.variants.push_back(registry().find(name).name);  // throws naming the known variants
+            if (opt.variants.empty()) throw Error("--variants names no variant");
         } else {
             argv[out++] = argv[i];
         }

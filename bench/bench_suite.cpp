@@ -36,6 +36,7 @@
 #include "demmat/error.hpp"
 #include "demmat/output.hpp"
 #include "demmat/registry.hpp"
+#include "demmat/text.hpp"
 #include "demmat/scenes.hpp"
 #include "demmat/state.hpp"
 #include "demmat/threads.hpp"
@@ -370,18 +371,12 @@ void parse_own_options(int& argc, char** argv)
             opt.states_dir = v;
         } else if (const char* v = value("--families=")) {
             opt.families.clear();
-            std::string cur;
-            for (const char* p = v;; ++p) {
-                if (*p == ',' || *p == '\0') {
-                    if (cur != "phases" && cur != "figure4" && cur != "cellsize" && cur != "stream")
-                        throw Error(fmt::format("unknown family '{}' in --families (known: phases, figure4, cellsize, stream)", cur));
-                    opt.families.insert(cur);
-                    cur.clear();
-                    if (*p == '\0') break;
-                } else {
-                    cur += *p;
-                }
+            for (const std::string& family : split_list(v)) {
+                if (family != "phases" && family != "figure4" && family != "cellsize" && family != "stream")
+                    throw Error(fmt::format("unknown family '{}' in --families (known: phases, figure4, cellsize, stream)", family));
+                opt.families.insert(family);
             }
+            if (opt.families.empty()) throw Error("--families names no family (known: phases, figure4, cellsize, stream)");
         } else {
             argv[out++] = argv[i];
         }
