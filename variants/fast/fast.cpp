@@ -87,16 +87,8 @@ public:
         // Cells at least as wide as the longest listed pair; a wider scene cell is honoured (it only
         // changes the candidates, never the contact set).
         cell_ = T(std::max(setup.cell_size, 2.0 * setup.radius_max)) + skin_;
-        for (auto* arr : {&x_, &v_, &a_, &b3_, &b4_, &b5_, &th_, &w_, &al_, &r3_, &r4_, &r5_, &f_, &t_, &acc_, &alc_, &xref_, &tmp_})
-            arr->assign(3 * n_, T(0));
-        auto load = [this](std::vector<T>& dst, const std::vector<Vec3d>& src) {
-            for (std::size_t i = 0; i < n_; ++i)
-                for (int c = 0; c < 3; ++c) dst[c * n_ + i] = T(component(src[i], c));
-        };
-        load(x_, s.trans.x); load(v_, s.trans.v); load(a_, s.trans.a);
-        load(b3_, s.trans.b3); load(b4_, s.trans.b4); load(b5_, s.trans.b5);
-        load(th_, s.rot.x); load(w_, s.rot.v); load(al_, s.rot.a);
-        load(r3_, s.rot.b3); load(r4_, s.rot.b4); load(r5_, s.rot.b5);
+        load_gear_columns<T>(s, {&x_, &v_, &a_, &b3_, &b4_, &b5_, &th_, &w_, &al_, &r3_, &r4_, &r5_});
+        for (auto* arr : {&f_, &t_, &acc_, &alc_, &xref_, &tmp_}) arr->assign(3 * n_, T(0));
         r_.resize(n_); m_.resize(n_); I_.resize(n_); id_.resize(n_); pos_.resize(n_); tmp1_.resize(n_); tmpi_.resize(n_);
         for (std::size_t i = 0; i < n_; ++i) {
             r_[i] = T(s.radius[i]);

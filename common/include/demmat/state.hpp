@@ -2,6 +2,7 @@
 // The full dynamic state of a run, in particle-id order: every Gear value for translation and
 // rotation, the walls and the step count. A run saved and continued from this state is bit-identical
 // to a run that never stopped.
+#include <array>
 #include <cstdint>
 #include <filesystem>
 #include <string>
@@ -29,6 +30,21 @@ struct State {
     std::size_t size() const { return radius.size(); }
     void resize(std::size_t n) { radius.resize(n); trans.resize(n); rot.resize(n); }
 };
+
+// The twelve Gear arrays of a state (translation x, v, a, b3, b4, b5, then rotation) in the column
+// layout of the array-based variants: each an array of 3N, an x block, a y block, a z block, in T.
+template <class T>
+void load_gear_columns(const State& s, const std::array<std::vector<T>*, 12>& dst)
+{
+    const std::vector<Vec3d>* src[12] = {&s.trans.x, &s.trans.v, &s.trans.a, &s.trans.b3, &s.trans.b4, &s.trans.b5,
+                                         &s.rot.x,   &s.rot.v,   &s.rot.a,   &s.rot.b3,   &s.rot.b4,   &s.rot.b5};
+    const std::size_t n = s.size();
+    for (int k = 0; k < 12; ++k) {
+        dst[k]->assign(3 * n, T(0));
+        for (std::size_t i = 0; i < n; ++i)
+            for (int c = 0; c < 3; ++c) (*dst[k])[std::size_t(c) * n + i] = T(component((*src[k])[i], c));
+    }
+}
 
 // Binary state file (format in docs/state-format.md); written to a temporary file and renamed.
 void save_state(const State& state, const std::filesystem::path& file);
