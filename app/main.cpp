@@ -174,6 +174,9 @@ int cmd_run(const RunArgs& a)
     std::cout << fmt::format("contacts per particle {:.3f} (particle-particle {}, particle-wall {})  kinetic energy {:.6e} J\n",
                              (2.0 * double(c.particle_particle) + double(c.particle_wall)) / n, c.particle_particle,
                              c.particle_wall, ke);
+    if (l->scene.checks.interval > 0)
+        std::cout << fmt::format("largest overlap at the health checks {:.3g} of the smaller radius (bound {})\n",
+                                 driver.largest_overlap_ratio(), l->scene.checks.max_overlap_ratio);
     std::cout << fmt::format("PERFORMANCE variant={} particles={} steps={} us_per_particle_step={:.5f} seconds={:.4f}\n",
                              info.name, l->state.size(), steps, t.total() * per / n * 1e6, wall);
 
@@ -199,6 +202,7 @@ int cmd_run(const RunArgs& a)
                   {"contacts", {{"particle_particle", c.particle_particle}, {"particle_wall", c.particle_wall},
                                 {"per_particle", (2.0 * double(c.particle_particle) + double(c.particle_wall)) / n}}},
                   {"kinetic_energy", ke},
+                  {"largest_overlap_ratio", driver.largest_overlap_ratio()},
                   {"memory_bytes", variant->memory_bytes()}};
         write_atomically(a.json_file, j.dump(2) + "\n");
     }
@@ -324,6 +328,7 @@ struct SceneArgs {
     std::string kind, out, from, state;
     std::int64_t count = 0;
     std::uint64_t seed = 1;
+    std::int64_t max_layers = 20;
     double speed = -1.0, gap = 0.001;
 };
 
@@ -331,7 +336,7 @@ int cmd_scene(const SceneArgs& a)
 {
     Scene s;
     if (a.kind == "paper") s = paper_scene(a.count > 0 ? a.count : 1000, a.seed);
-    else if (a.kind == "dense-bed") s = dense_bed_scene(a.count > 0 ? a.count : 2000, a.seed);
+    else if (a.kind == "dense-bed") s = dense_bed_scene(a.count > 0 ? a.count : 2000, a.seed, a.max_layers);
     else if (a.kind == "head-on") s = head_on_scene(a.speed >= 0.0 ? a.speed : 1.0);
     else if (a.kind == "drop") s = drop_scene(a.gap);
     else if (a.kind == "compression") {
@@ -370,6 +375,7 @@ int main(int argc, char** argv)
     scene->add_option("--out,-o", sa.out, "Output file");
     scene->add_option("--n", sa.count, "Number of particles (paper: 1000, dense-bed: 2000)");
     scene->add_option("--seed", sa.seed, "Seed of the particle generator");
+    scene->add_option("--max-layers", sa.max_layers, "dense-bed: at most this many lattice layers; more grains make the bed wider");
     scene->add_option("--speed", sa.speed, "head-on: relative speed (m/s); compression: wall speed (m/s)");
     scene->add_option("--gap", sa.gap, "drop: initial gap between the sphere and the wall (m)");
     scene->add_option("--from", sa.from, "compression: the scene that was settled");

@@ -177,6 +177,7 @@ void Driver::check_health()
             if (s < 0.0)
                 throw InstabilityError(fmt::format("step {}: particle {} passed through wall '{}' ({})", step_, i, w.name, hint),
                                        step_, std::int64_t(i));
+            largest_overlap_ratio_ = std::max(largest_overlap_ratio_, (st.radius[i] - s) / st.radius[i]);
             if ((st.radius[i] - s) > ratio * st.radius[i])
                 throw InstabilityError(fmt::format("step {}: particle {} overlaps wall '{}' by {:.3g} of its radius, above "
                                                    "the bound {} ({})", step_, i, w.name, (st.radius[i] - s) / st.radius[i], ratio, hint),
@@ -188,6 +189,7 @@ void Driver::check_health()
         const Vec3d d = scratch_.position[j] - scratch_.position[i];
         const double h = st.radius[i] + st.radius[j] - std::sqrt(dot(d, d));
         const double r = std::min(st.radius[i], st.radius[j]);
+        largest_overlap_ratio_ = std::max(largest_overlap_ratio_, h / r);
         if (h > ratio * r)
             throw InstabilityError(fmt::format("step {}: particles {} and {} overlap by {:.3g} of the smaller radius, above "
                                                "the bound {} ({})", step_, i, j, h / r, ratio, hint), step_, i);

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "demmat/error.hpp"
+
 #include <fmt/format.h>
 
 namespace demmat {
@@ -34,14 +36,14 @@ Scene paper_scene(std::int64_t count, std::uint64_t seed)
     return s;
 }
 
-Scene dense_bed_scene(std::int64_t count, std::uint64_t seed)
+Scene dense_bed_scene(std::int64_t count, std::uint64_t seed, std::int64_t max_layers)
 {
     Scene s = paper_scene(count, seed);
     s.name = fmt::format("dense_bed_{}", count);
     // A cube of sites up to 20 layers (N = 8000); beyond, wider, not taller: a taller column of this soft
     // material falls faster and its collapse drives overlaps past the health bound (0.5·R at N = 27000),
     // and a fixed depth keeps the pressure profile, hence the contacts per grain, alike across N.
-    constexpr std::int64_t max_layers = 20;
+    if (max_layers < 1) throw Error(fmt::format("dense bed: at most {} layers is not a bed (need at least 1)", max_layers));
     auto side = std::int64_t(std::ceil(std::cbrt(double(count)) - 1e-9));
     if (side > max_layers) side = std::int64_t(std::ceil(std::sqrt(double(count) / double(max_layers)) - 1e-9));
     const std::int64_t nz = (count + side * side - 1) / (side * side);

@@ -32,6 +32,9 @@ public:
     double time() const { return double(step_) * setup_.gear.dt; }
     const PhaseTimes& times() const { return times_; }
     std::int64_t steps_taken() const { return steps_taken_; }
+    // The largest overlap seen by the health checks so far, over the smaller radius (particle pairs)
+    // or the radius (walls): how close the run came to the scene's max_overlap_ratio.
+    double largest_overlap_ratio() const { return largest_overlap_ratio_; }
     Variant& variant() { return variant_; }
     const Setup& setup() const { return setup_; }
 
@@ -46,6 +49,7 @@ private:
     PhaseTimes times_;
     Snapshot scratch_;
     double speed_bound_;
+    double largest_overlap_ratio_ = 0.0;
     // Energy-growth check (docs/stability.md): start positions and energy, the tolerance's floor; off
     // when a wall moves (its work is not tracked).
     std::vector<Vec3d> x0_;
