@@ -104,6 +104,7 @@ public:
             }
         place_walls(step_);
         pstart_.assign(n_ + 1, 0);
+        near_wall_.assign(n_, 0);
         lstart_.assign(n_ + 1, 0);
         key_.resize(n_);
         rebuilds_ = 0;
@@ -225,7 +226,8 @@ public:
             b += arr->capacity() * sizeof(T);
         for (const auto* arr : {&id_, &pos_, &tmpi_, &pstart_, &partner_, &owner_, &lstart_, &lslot_, &cstart_})
             b += arr->capacity() * sizeof(Index);
-        b += slot_.capacity() * sizeof(Slot<T>) + key_.capacity() * sizeof(key_[0]) + cell3_.capacity() * sizeof(std::int64_t);
+        b += slot_.capacity() * sizeof(Slot<T>) + coef_.capacity() * sizeof(Coefficients<T>) + touch_.capacity() + near_wall_.capacity();
+        b += key_.capacity() * sizeof(key_[0]) + cell3_.capacity() * sizeof(std::int64_t);
         for (const auto& f : foreign_) b += f.capacity() * sizeof(Foreign<T>);
         return b;
     }
@@ -256,43 +258,51 @@ private:
     static constexpr int kLanes = native_lanes<T>;
     static constexpr std::size_t kBlock = 512;
 
-    // Slots [k0, k1) (owner s, partner q; id(s) < id(q)): each gets its contact, or zeros. Zeros add
-    // nothing: a sum that starts at +0 is never -0, and x + ±0 = x for every other x, so adding a
-    // rejected slot's zeros leaves the bits of arrays, which skips it. may_touch first, a cheap and
-    // conservative test (the law rejects every pair it rejects), so the skin's extra candidates cost a
-    // distance, not a pass through the law; the rest go through the law kLanes at a time. Returns the
-    // contacts found.
+    // Slots [k0, k1) (owner s, partner q; id(s) < id(q)): touch[k] says whether the pair is in contact
+    // and slot[k] holds its contact. A canonical sum reads every slot of a particle: a pair out of contact
+    // holds zeros, which add nothing (a sum that starts at +0 is never -0, and x + ±0 = x for every other
+    // x), so the bits are those of arrays, which skips the pair; reading zeros costs less than a branch
+    // that is taken at random. may_touch first, a cheap and conservative test (the law rejects every pair
+    // it rejects), so the skin's extra candidates cost a distance, not a pass through the law; the rest go
+    // through the law kLanes at a time. The test sorts the slots into kept and dropped without a branch
+    // (a third are dropped, in no pattern a predictor learns). Returns the contacts found.
     std::int64_t slots_of(std::size_t k0, std::size_t k1)
     {
         const Index* owner = owner_.data();
         const Index* partner = partner_.data();
-        std::size_t pending[kLanes];
-        int fill = 0;
+        const T* x = x_.data();
+        const T* r = r_.data();
+        const std::size_t n = n_;
+        std::size_t kept[kBlock], dropped[kBlock];
         std::int64_t found = 0;
-        for (std::size_t k = k0; k < k1; ++k) {
-            const std::size_t s = std::size_t(owner[k]), q = std::size_t(partner[k]);
-            if (!may_touch(get(x_, s), get(x_, q), r_[s], r_[q])) {
-                slot_[k] = Slot<T>{};
-                continue;
+        for (std::size_t c0 = k0; c0 < k1; c0 += kBlock) {
+            const std::size_t c1 = std::min(k1, c0 + kBlock);
+            std::size_t nk = 0, nd = 0;
+            for (std::size_t k = c0; k < c1; ++k) {
+                const std::size_t s = std::size_t(owner[k]), q = std::size_t(partner[k]);
+                const bool t = may_touch(Vec3<T>{x[s], x[n + s], x[2 * n + s]}, Vec3<T>{x[q], x[n + q], x[2 * n + q]}, r[s], r[q]);
+                kept[nk] = k;
+                dropped[nd] = k;
+                nk += std::size_t(t);
+                nd += std::size_t(!t);
             }
-            pending[fill++] = k;
-            if (fill == kLanes) {
-                found += pack_of_slots(pending, fill);
-                fill = 0;
-            }
+            for (std::size_t e = 0; e < nd; ++e) touch_[dropped[e]] = 0;
+            if (opt_.canonical)
+                for (std::size_t e = 0; e < nd; ++e) slot_[dropped[e]] = Slot<T>{};
+            for (std::size_t e = 0; e < nk; e += kLanes) found += pack_of_slots(kept + e, int(std::min<std::size_t>(kLanes, nk - e)));
         }
-        if (fill > 0) found += pack_of_slots(pending, fill);
         return found;
     }
 
     // The law for up to kLanes slots at once (unused lanes repeat the last slot and are not stored):
-    // gather both particles of each slot into the lanes, run particle_contact_lanes, scatter the lanes
-    // back into the slots. Each lane's bits are those particle_contact gives for its slot's pair.
+    // gather both particles of each slot and the pair's coefficients (computed when it was listed) into
+    // the lanes, run particle_contact_lanes, scatter the lanes in contact back into the slots. Each
+    // lane's bits are those particle_contact gives for its slot's pair.
     int pack_of_slots(const std::size_t* ks, int count)
     {
-        static_assert(M::polydisperse, "the lanes get no monodisperse coefficients");
         Vec3<Lanes> xi, xj, vi, vj, wi, wj;
-        Lanes ri{}, rj{}, mi{}, mj{};
+        Lanes ri{}, rj{};
+        Coefficients<Lanes> kc;
         const std::size_t n = n_;
         for (int l = 0; l < kLanes; ++l) {
             const std::size_t k = ks[l < count ? l : count - 1];
@@ -304,19 +314,22 @@ private:
             wi.x[l] = w_[s]; wi.y[l] = w_[n + s]; wi.z[l] = w_[2 * n + s];
             wj.x[l] = w_[q]; wj.y[l] = w_[n + q]; wj.z[l] = w_[2 * n + q];
             ri[l] = r_[s]; rj[l] = r_[q];
-            mi[l] = m_[s]; mj[l] = m_[q];
+            kc.kn[l] = coef_[k].kn; kc.cn[l] = coef_[k].cn; kc.ct[l] = coef_[k].ct;
         }
         ContactForce<Lanes> c;
-        const auto touch = particle_contact_lanes<M>(xi, xj, vi, vj, wi, wj, ri, rj, mi, mj, params_, Coefficients<Lanes>{}, c);
+        // (The masses only enter the coefficients, so the law does not read them here.)
+        const auto touch = particle_contact_lanes<CoefficientsGiven<M>>(xi, xj, vi, vj, wi, wj, ri, rj, Lanes{}, Lanes{}, params_, kc, c);
         int found = 0;
         for (int l = 0; l < count; ++l) {
-            Slot<T>& out = slot_[ks[l]];
+            const std::size_t k = ks[l];
+            touch_[k] = std::uint8_t(touch[l] != 0);
+            found += touch_[k];
+            Slot<T>& out = slot_[k];
             out.f = {c.f_i.x[l], c.f_i.y[l], c.f_i.z[l]};
             if constexpr (M::rotation) {
                 out.ti = {c.t_i.x[l], c.t_i.y[l], c.t_i.z[l]};
                 out.tj = {c.t_j.x[l], c.t_j.y[l], c.t_j.z[l]};
             }
-            found += int(touch[l] != 0);
         }
         return found;
     }
@@ -328,17 +341,20 @@ private:
         const Index* pstart = pstart_.data();
         const Index* lstart = lstart_.data();
         const Index* lslot = lslot_.data();
-        Slot<T>* slot = slot_.data();
+        const Slot<T>* slot = slot_.data();
+        const std::uint8_t* near_wall = near_wall_.data();
         const std::size_t total = partner_.size(), blocks = (total + kBlock - 1) / kBlock;
-#pragma omp parallel if (par_)
+#pragma omp parallel reduction(+ : pp, pw) if (par_)
         {
             // Every contact once, into its slot, a pack of candidates at a time.
-#pragma omp for schedule(static) reduction(+ : pp)
+#pragma omp for schedule(static)
             for (std::size_t b = 0; b < blocks; ++b) pp += slots_of(b * kBlock, std::min(total, (b + 1) * kBlock));
             // Each particle's sum in the canonical order: as j (partners of lower id, ascending), as i
-            // (partners of higher id, ascending), its walls in wall order; then Newton.
-#pragma omp for schedule(static) reduction(+ : pw)
-            for (std::size_t s = 0; s < n; ++s) {
+            // (partners of higher id, ascending), its walls in wall order; then Newton. The pairs not in
+            // contact are skipped, as arrays skips them.
+            const auto [lo, hi] = thread_range(n);
+            mark_walls(lo, hi);
+            for (std::size_t s = lo; s < hi; ++s) {
                 Vec3<T> F{}, Tq{};
                 for (Index e = lstart[s]; e < lstart[s + 1]; ++e) {
                     const Slot<T>& c = slot[lslot[e]];
@@ -350,7 +366,7 @@ private:
                     F += c.f;
                     if constexpr (M::rotation) Tq += c.ti;
                 }
-                pw += walls_of(s, F, Tq);
+                if (near_wall[s]) pw += walls_of(s, F, Tq);
                 finish(s, F, Tq);
             }
         }
@@ -358,9 +374,33 @@ private:
         pw_ = pw;
     }
 
-    // Walls of particle s in wall order, added to F and Tq; returns the contacts found. A scene has a
-    // handful of walls: testing each every step (may_touch_wall, a dot product) costs less than a wall
-    // list, and keeps the moving wall out of the rebuild criterion.
+    // This thread's share of the particles, [lo, hi) (inside a parallel region; all of them outside).
+    static std::pair<std::size_t, std::size_t> thread_range(std::size_t n)
+    {
+        const std::size_t nt = std::size_t(thread_count()), t = std::size_t(thread_index());
+        return {n * t / nt, n * (t + 1) / nt};
+    }
+
+    // near_wall[s] for s in [lo, hi): may s touch any wall (may_touch_wall, vectorised over the
+    // particles, a wall at a time)? Only those go through walls_of; in a bed most touch none. A scene
+    // has a handful of walls: testing each every step costs less than a wall list, and keeps the moving
+    // wall out of the rebuild criterion.
+    void mark_walls(std::size_t lo, std::size_t hi)
+    {
+        const std::size_t n = n_;
+        const T* __restrict x = x_.data();
+        const T* __restrict r = r_.data();
+        std::uint8_t* __restrict near = near_wall_.data();
+        std::fill(near + lo, near + hi, std::uint8_t(0));
+        for (std::size_t w = 0; w < nw_; ++w) {
+            const Vec3<T> p = wall_point(w), nrm = wall_normal(w);
+#pragma omp simd
+            for (std::size_t s = lo; s < hi; ++s)
+                near[s] |= std::uint8_t(may_touch_wall(Vec3<T>{x[s], x[n + s], x[2 * n + s]}, r[s], p, nrm));
+        }
+    }
+
+    // Walls of particle s in wall order, added to F and Tq; returns the contacts found.
     std::int64_t walls_of(std::size_t s, Vec3<T>& F, Vec3<T>& Tq) const
     {
         std::int64_t found = 0;
@@ -402,7 +442,7 @@ private:
 #pragma omp parallel reduction(+ : pp, pw) if (par_)
         {
             const std::size_t nt = std::size_t(thread_count()), t = std::size_t(thread_index());
-            const std::size_t lo = n * t / nt, hi = n * (t + 1) / nt;
+            const auto [lo, hi] = thread_range(n);
             for (std::size_t s = lo; s < hi; ++s) {
                 put(f_, s, {});
                 put(t_, s, {});
@@ -411,14 +451,14 @@ private:
             queue.clear();
             // The contacts of this thread's particles, a pack at a time, then added up as they come.
             pp += slots_of(std::size_t(pstart_[lo]), std::size_t(pstart_[hi]));
+            mark_walls(lo, hi);
 #pragma omp barrier
             for (std::size_t s = lo; s < hi; ++s) {
                 Vec3<T> F{}, Tq{};
                 for (Index k = pstart_[s]; k < pstart_[s + 1]; ++k) {
+                    if (!touch_[std::size_t(k)]) continue;  // not in contact: nothing to add, no write to the partner
                     const std::size_t q = std::size_t(partner_[k]);
                     const Slot<T>& c = slot_[std::size_t(k)];
-                    // A rejected candidate's zeros: nothing to add, and no write to the partner.
-                    if (c.f == Vec3<T>{} && (!M::rotation || (c.ti == Vec3<T>{} && c.tj == Vec3<T>{}))) continue;
                     F += c.f;
                     if constexpr (M::rotation) Tq += c.ti;
                     if (q >= lo && q < hi) {
@@ -428,7 +468,7 @@ private:
                         queue.push_back({Index(q), -c.f, c.tj});
                     }
                 }
-                pw += walls_of(s, F, Tq);
+                if (near_wall_[s]) pw += walls_of(s, F, Tq);
                 add(f_, s, F);
                 add(t_, s, Tq);
             }
@@ -574,36 +614,54 @@ private:
         auto near = [&](std::size_t s, std::size_t q) {
             return id_[q] > id_[s] && may_touch(get(x_, s), get(x_, q), r_[s] + half_skin, r_[q] + half_skin);
         };
+        // One scan of the cells: each thread lists its particles' partners in a buffer of its own, then
+        // (after the counts' prefix sum) copies them into place.
         Index* pstart = pstart_.data();
-#pragma omp parallel for schedule(static) if (par_)
-        for (std::size_t s = 0; s < n; ++s) {
-            Index c = 0;
-            for_each_near(s, [&](std::size_t q) { c += Index(near(s, q)); });
-            pstart[s + 1] = c;
-        }
-        pstart[0] = 0;
-        for (std::size_t s = 0; s < n; ++s) pstart[s + 1] += pstart[s];
-        const std::size_t total = std::size_t(pstart[n]);
-        partner_.resize(total);
-        owner_.resize(total);
-        slot_.resize(total);
-        Index* partner = partner_.data();
-        Index* owner = owner_.data();
+        if (scan_.size() < std::size_t(thread_limit())) scan_.resize(std::size_t(thread_limit()));
         const bool canonical = opt_.canonical;
-#pragma omp parallel for schedule(static) if (par_)
-        for (std::size_t s = 0; s < n; ++s) {
-            Index k = pstart[s];
-            for_each_near(s, [&](std::size_t q) {
-                if (!near(s, q)) return;
-                partner[k] = Index(q);
-                owner[k] = Index(s);
-                ++k;
-            });
-            // Canonical: partners by ascending id. Unordered: the scan's order (ascending storage).
-            if (canonical)
-                std::sort(partner + pstart[s], partner + pstart[s + 1], [this](Index a, Index b) { return id_[a] < id_[b]; });
+        std::size_t total = 0;
+#pragma omp parallel if (par_)
+        {
+            const auto [lo, hi] = thread_range(n);
+            std::vector<Index>& mine = scan_[std::size_t(thread_index())];
+            mine.clear();
+            for (std::size_t s = lo; s < hi; ++s) {
+                const std::size_t before = mine.size();
+                for_each_near(s, [&](std::size_t q) {
+                    if (near(s, q)) mine.push_back(Index(q));
+                });
+                pstart[s + 1] = Index(mine.size() - before);
+            }
+#pragma omp barrier
+#pragma omp single
+            {
+                pstart[0] = 0;
+                for (std::size_t s = 0; s < n; ++s) pstart[s + 1] += pstart[s];
+                total = std::size_t(pstart[n]);
+                partner_.resize(total);
+                owner_.resize(total);
+                slot_.resize(total);
+                touch_.resize(total);
+                coef_.resize(total);
+            }
+            Index* partner = partner_.data();
+            Index* owner = owner_.data();
+            std::copy(mine.begin(), mine.end(), partner + pstart[lo]);
+            for (std::size_t s = lo; s < hi; ++s) {
+                std::fill(owner + pstart[s], owner + pstart[s + 1], Index(s));
+                // Canonical: partners by ascending id. Unordered: the scan's order (ascending storage).
+                if (canonical)
+                    std::sort(partner + pstart[s], partner + pstart[s + 1], [this](Index a, Index b) { return id_[a] < id_[b]; });
+                // The law's coefficients of each listed pair (i = s, the lower id), once per rebuild.
+                for (Index e = pstart[s]; e < pstart[s + 1]; ++e) {
+                    const std::size_t q = std::size_t(partner[e]);
+                    coef_[std::size_t(e)] = pair_coefficients(r_[s], r_[q], m_[s], m_[q], params_);
+                }
+            }
         }
         if (!canonical) return;
+        Index* partner = partner_.data();
+        Index* owner = owner_.data();
         // The slots where each particle is the partner, by ascending id of the owner.
         Index* lstart = lstart_.data();
         std::fill(lstart_.begin(), lstart_.end(), 0);
@@ -637,12 +695,16 @@ private:
     // The neighbour list: pairs of s in [pstart[s], pstart[s+1]), one slot each; where s is the partner.
     std::vector<Index> pstart_, partner_, owner_, lstart_, lslot_;
     std::vector<Slot<T>> slot_;
+    std::vector<Coefficients<T>> coef_;     // each listed pair's law coefficients (pair_coefficients)
+    std::vector<std::uint8_t> touch_;       // each listed pair: in contact this step (then slot_ holds it)
+    std::vector<std::uint8_t> near_wall_;   // (N) may touch a wall this step
     std::vector<Key> key_, keytmp_;
     std::vector<std::int64_t> cell3_;  // (3N) cell coordinates at the last rebuild
     std::vector<Index> cstart_;        // first storage slot of each cell (dense grid), cells + 1
     bool dense_ = true;
     std::int64_t dims_[2] = {0, 0};
     std::vector<std::vector<Foreign<T>>> foreign_;  // per thread (unordered mode)
+    std::vector<std::vector<Index>> scan_;          // per thread: partners found by list_pairs' scan
     std::int64_t pp_ = 0, pw_ = 0;
 };
 
