@@ -328,7 +328,7 @@ struct SceneArgs {
     std::string kind, out, from, state;
     std::int64_t count = 0;
     std::uint64_t seed = 1;
-    std::int64_t max_layers = 20;
+    std::int64_t max_layers = dense_bed_max_layers;
     double speed = -1.0, gap = 0.001;
 };
 

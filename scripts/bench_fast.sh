@@ -6,11 +6,12 @@
 # Writes results/fast/bench_settled_<N>_t<threads>.json (+ .txt), results/fast/million.txt and the table
 # results/fast/summary.md (analysis/summarise_fast.py).
 # Usage: scripts/bench_fast.sh [--sizes "1000 10000 100000"] [--threads "1 2"] [--repetitions R]
-#                              [--settle-time T] [--no-million] [--build DIR]
+#                              [--settle-time T] [--no-million] [--settle-only] [--build DIR]
+# --settle-only: settle the beds (the slow, once-only part) and stop.
 # Timed steps per repetition are 5·10^6/N (at least 20), so each sample is ~10^6–10^7 particle-steps.
 set -euo pipefail
 cd "$(dirname "$0")/.."
-sizes="1000 10000 100000"; threads="1 2"; reps=5; settle=0.4; million=1; build=build
+sizes="1000 10000 100000"; threads="1 2"; reps=5; settle=0.4; million=1; build=build; settle_only=0
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --sizes) sizes="$2"; shift 2 ;;
@@ -18,8 +19,9 @@ while [[ $# -gt 0 ]]; do
     --repetitions) reps="$2"; shift 2 ;;
     --settle-time) settle="$2"; shift 2 ;;
     --no-million) million=0; shift ;;
+    --settle-only) settle_only=1; million=0; shift ;;
     --build) build="$2"; shift 2 ;;
-    *) echo "bench_fast.sh: unknown option $1 (expected --sizes, --threads, --repetitions, --settle-time, --no-million, --build)" >&2; exit 2 ;;
+    *) echo "bench_fast.sh: unknown option $1 (expected --sizes, --threads, --repetitions, --settle-time, --no-million, --settle-only, --build)" >&2; exit 2 ;;
   esac
 done
 
@@ -33,13 +35,17 @@ mkdir -p scenes states results/fast
 
 for n in $sizes; do
   bed=scenes/dense_bed_${n}.toml
-  [[ -f "$bed" ]] || $demmat scene dense-bed --n "$n" -o "$bed"
   state=states/dense_bed_${n}_settled_fast.state
+  settled=scenes/dense_bed_${n}_settled.toml
+  # The state and the settled scene derive from the bed: a bed the generator no longer makes goes, with them.
+  $demmat scene dense-bed --n "$n" -o "$bed.new"
+  if ! cmp -s "$bed.new" "$bed"; then rm -f "$state" "$settled"; mv "$bed.new" "$bed"; fi
+  rm -f "$bed.new"
   if [[ ! -f "$state" ]]; then
     echo "== settling the dense bed of $n particles ($settle s simulated, fast on every core; done once)"
     $demmat run "$bed" --variant fast --time "$settle" --save "$state" -q --json results/fast/settle_${n}.json
   fi
-  settled=scenes/dense_bed_${n}_settled.toml
+  [[ $settle_only == 1 ]] && continue
   # The settled bed continuing from its state, walls at rest (a compression stage of speed 0).
   [[ -f "$settled" ]] || $demmat scene compression --from "$bed" --state "$state" --speed 0 -o "$settled"
   steps=$(( 5000000 / n )); (( steps < 20 )) && steps=20
@@ -50,11 +56,12 @@ for n in $sizes; do
       --repetitions "$reps" --threads "$t" --json "$out.json" | tee "$out.txt"
   done
 done
+[[ $settle_only == 1 ]] && exit 0
 
 if [[ $million == 1 ]]; then
   echo "== 10^6 particles: 20 steps of fast from the loose lattice (memory and time)"
   big=scenes/dense_bed_1000000.toml
-  [[ -f "$big" ]] || $demmat scene dense-bed --n 1000000 -o "$big"
+  $demmat scene dense-bed --n 1000000 -o "$big"
   /usr/bin/time -v $demmat run "$big" --variant fast --steps 20 -q --json results/fast/million.json \
     > results/fast/million.txt 2> results/fast/million_time.txt
   grep -E "Maximum resident|Elapsed" results/fast/million_time.txt | tee -a results/fast/million.txt

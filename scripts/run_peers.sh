@@ -8,12 +8,13 @@
 #  2. the physics cross-check: an ensemble of perturbed starts per code from the same particles, the
 #     kinetic energy and bed height while settling, the wall force while compressing; results/peers/physics_*.
 # Usage: scripts/run_peers.sh [--full] [--n "1000 2000"] [--steps K] [--repetitions R] [--variants LIST]
-#                             [--members M] [--physics-n N] [--bench-only] [--physics-only]
+#                             [--members M] [--physics-n N] [--bench-only] [--physics-only] [--prepare-only]
 #   --full  N = 1000 … 64000 (doubling), 500 steps, 5 repetitions, 8 ensemble members (the lead's run)
+#   --prepare-only  settle and export the stages of every N (the slow part, done once), then stop
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ns="1000 2000 4000"; steps=200; reps=3; variants=all; members=4; phys_n=2000; warmup=20
-do_bench=1; do_phys=1
+do_bench=1; do_phys=1; prepare_only=0
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --full) ns="1000 2000 4000 8000 16000 32000 64000"; steps=500; reps=5; members=8; shift ;;
@@ -25,7 +26,8 @@ while [[ $# -gt 0 ]]; do
     --physics-n) phys_n="$2"; shift 2 ;;
     --bench-only) do_phys=0; shift ;;
     --physics-only) do_bench=0; shift ;;
-    *) echo "run_peers.sh: unknown option $1 (expected --full, --n, --steps, --repetitions, --variants, --members, --physics-n, --bench-only, --physics-only)" >&2; exit 2 ;;
+    --prepare-only) prepare_only=1; shift ;;
+    *) echo "run_peers.sh: unknown option $1 (expected --full, --n, --steps, --repetitions, --variants, --members, --physics-n, --bench-only, --physics-only, --prepare-only)" >&2; exit 2 ;;
   esac
 done
 
@@ -61,7 +63,13 @@ settler=arrays; $demmat list | grep -q "^fast " && settler=fast
 prepare() {
   local n=$1 d=$work/n$1
   mkdir -p "$d"
-  [[ -f $d/loose.toml ]] || $demmat scene dense-bed --n "$n" -o "$d/loose.toml"
+  # Everything kept here derives from the bed: a bed the generator no longer makes is dropped, with all of it.
+  $demmat scene dense-bed --n "$n" -o "$d/loose.toml.new"
+  if ! cmp -s "$d/loose.toml.new" "$d/loose.toml"; then
+    find "$d" -mindepth 1 ! -name loose.toml.new -delete
+    mv "$d/loose.toml.new" "$d/loose.toml"
+  fi
+  rm -f "$d/loose.toml.new"
   if [[ ! -f $d/settled.state ]]; then
     echo "== settling the dense bed of $n particles (0.4 s simulated, once; kept in $d)"
     # fast on every core where it is built: bit-identical to arrays, so the same settled state, sooner.
@@ -73,6 +81,12 @@ prepare() {
     [[ -f $d/$stage.data ]] || $demmat export-lammps "$d/$stage.toml" -o "$d/$stage.data"
   done
 }
+
+if [[ $prepare_only == 1 ]]; then
+  for n in $ns; do prepare "$n"; done
+  echo "run_peers.sh: stages of N = $ns ready in $work"
+  exit 0
+fi
 
 # "Loop time of X on 1 procs for K steps": the timed (last) run's seconds.
 loop_time() { grep "^Loop time of" "$1" | tail -1 | awk '{print $4}'; }

@@ -23,6 +23,23 @@ TEST(Generator, SameSeedSameStateOtherSeedOtherState)
     for (const Vec3d& v : a.trans.v) EXPECT_LE(std::sqrt(dot(v, v)), 1.0 + 1e-15);
 }
 
+TEST(Generator, DenseBedsGrowWiderNotDeeperBeyondTheLayerCap)
+{
+    // Up to 12³ grains a cube of sites; beyond, 12 layers and a wider square base (scenes.cpp says why).
+    auto layers = [](const Scene& s) { return s.grid->cells[2]; };
+    const Scene cube = dense_bed_scene(1000), bed2000 = dense_bed_scene(2000), wide = dense_bed_scene(64000);
+    EXPECT_EQ(cube.grid->cells[0], 10);
+    EXPECT_EQ(layers(cube), 10);
+    EXPECT_EQ(bed2000.grid->cells[0], 13);  // the main benchmark's bed (scenes/dense_bed_2000.toml)
+    EXPECT_EQ(layers(bed2000), 12);
+    EXPECT_EQ(layers(wide), 12);
+    EXPECT_GE(wide.grid->cells[0] * wide.grid->cells[1] * layers(wide), 64000);
+    EXPECT_LT(wide.grid->cells[0] * wide.grid->cells[1] * (layers(wide) - 1), 64000);  // no empty layer
+    EXPECT_DOUBLE_EQ(wide.domain.max.z, double(layers(wide)) * wide.grid->spacing);
+    EXPECT_EQ(layers(dense_bed_scene(64000, 1, 20)), 20);
+    EXPECT_THROW(dense_bed_scene(100, 1, 0), Error);
+}
+
 TEST(Generator, InitialAccelerationIsGravityWhenNothingTouches)
 {
     const State s = initial_state(paper_scene());

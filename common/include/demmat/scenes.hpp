@@ -13,9 +13,10 @@ namespace demmat {
 Scene paper_scene(std::int64_t count = 1000, std::uint64_t seed = 1);
 
 // A dense-bed family for any N: the paper's material, a closed box sized to the grains (a lattice of
-// nx·ny·nz sites 2.1·R_max apart, nx = ny = ceil(cbrt N), at most 20 layers deep: wider beyond N = 8000),
-// so cost per particle compares across N.
-Scene dense_bed_scene(std::int64_t count, std::uint64_t seed = 1, std::int64_t max_layers = 20);
+// nx·ny·nz sites 2.1·R_max apart, nx = ny = ceil(cbrt N), at most max_layers deep: wider beyond
+// N = max_layers³), so cost per particle compares across N.
+inline constexpr std::int64_t dense_bed_max_layers = 12;  // why 12: scenes.cpp
+Scene dense_bed_scene(std::int64_t count, std::uint64_t seed = 1, std::int64_t max_layers = dense_bed_max_layers);
 
 // Stage 2 of the paper's test from a settled state: the x_max wall moves inwards at `speed` m/s.
 Scene compression_scene(const Scene& settled, const std::filesystem::path& state_file, double speed = 0.5);
