@@ -286,9 +286,13 @@ private:
                 nk += std::size_t(t);
                 nd += std::size_t(!t);
             }
-            for (std::size_t e = 0; e < nd; ++e) touch_[dropped[e]] = 0;
-            if (opt_.canonical)
-                for (std::size_t e = 0; e < nd; ++e) slot_[dropped[e]] = Slot<T>{};
+            // A dropped slot is zeroed when it was not dropped the step before (most stay dropped).
+            for (std::size_t e = 0; e < nd; ++e) {
+                const std::size_t k = dropped[e];
+                if (!touch_[k]) continue;
+                touch_[k] = 0;
+                if (opt_.canonical) slot_[k] = Slot<T>{};
+            }
             for (std::size_t e = 0; e < nk; e += kLanes) found += pack_of_slots(kept + e, int(std::min<std::size_t>(kLanes, nk - e)));
         }
         return found;
@@ -641,7 +645,7 @@ private:
                 partner_.resize(total);
                 owner_.resize(total);
                 slot_.resize(total);
-                touch_.resize(total);
+                touch_.assign(total, 1);  // "maybe in contact": the first pass zeroes the slots it drops
                 coef_.resize(total);
             }
             Index* partner = partner_.data();
