@@ -258,9 +258,9 @@ private:
     static constexpr int kLanes = native_lanes<T>;
     static constexpr std::size_t kBlock = 512;
 
-    // Slots [k0, k1) (owner s, partner q; id(s) < id(q)): touch[k] says whether the pair is in contact
-    // and slot[k] holds its contact. A canonical sum reads every slot of a particle: a pair out of contact
-    // holds zeros, which add nothing (a sum that starts at +0 is never -0, and x + ±0 = x for every other
+    // Slots [k0, k1) (owner s, partner q; id(s) < id(q)): touch[k] says whether the pair is in contact,
+    // and then slot[k] holds its contact. A canonical sum reads every slot of a particle, so there a pair
+    // out of contact holds zeros, which add nothing (a sum that starts at +0 is never -0, and x + ±0 = x for every other
     // x), so the bits are those of arrays, which skips the pair; reading zeros costs less than a branch
     // that is taken at random. may_touch first, a cheap and conservative test (the law rejects every pair
     // it rejects), so the skin's extra candidates cost a distance, not a pass through the law; the rest go
@@ -300,8 +300,8 @@ private:
 
     // The law for up to kLanes slots at once (unused lanes repeat the last slot and are not stored):
     // gather both particles of each slot and the pair's coefficients (computed when it was listed) into
-    // the lanes, run particle_contact_lanes, scatter the lanes in contact back into the slots. Each
-    // lane's bits are those particle_contact gives for its slot's pair.
+    // the lanes, run particle_contact_lanes, scatter the lanes back into the slots (zeros where h <= 0).
+    // Each lane's bits are those particle_contact gives for its slot's pair.
     int pack_of_slots(const std::size_t* ks, int count)
     {
         Vec3<Lanes> xi, xj, vi, vj, wi, wj;
@@ -354,8 +354,7 @@ private:
 #pragma omp for schedule(static)
             for (std::size_t b = 0; b < blocks; ++b) pp += slots_of(b * kBlock, std::min(total, (b + 1) * kBlock));
             // Each particle's sum in the canonical order: as j (partners of lower id, ascending), as i
-            // (partners of higher id, ascending), its walls in wall order; then Newton. The pairs not in
-            // contact are skipped, as arrays skips them.
+            // (partners of higher id, ascending), its walls in wall order; then Newton.
             const auto [lo, hi] = thread_range(n);
             mark_walls(lo, hi);
             for (std::size_t s = lo; s < hi; ++s) {
