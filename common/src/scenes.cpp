@@ -42,9 +42,9 @@ Scene dense_bed_scene(std::int64_t count, std::uint64_t seed, std::int64_t max_l
     s.name = fmt::format("dense_bed_{}", count);
     // A cube of sites up to max_layers (12: N = 1728); beyond, wider, not taller. Grains of this soft
     // material (E = 3·10⁵ Pa) start with random speeds up to 1 m/s and fall as the lattice collapses; the
-    // deepest overlap while settling grows with the depth: 0.36 of the smaller radius at 12 layers, 0.42
-    // at 16 and 0.49 at 20 (N = 8000–16000), against the health bound of 0.5, which a bed of 16000 at 20
-    // layers passed. A fixed depth also keeps the pressure profile, hence the contacts per grain, alike
+    // deepest overlap while settling grows with the depth: 0.49 of the smaller radius at 20 layers
+    // (N = 8000; a bed of 16000 passed the health bound of 0.5), 0.42 at 16 (N = 16000), 0.31–0.42 at 12
+    // (N = 10³–10⁵). A fixed depth also keeps the pressure profile, hence the contacts per grain, alike
     // across N.
     if (max_layers < 1) throw Error(fmt::format("dense bed: at most {} layers is not a bed (need at least 1)", max_layers));
     auto side = std::int64_t(std::ceil(std::cbrt(double(count)) - 1e-9));
