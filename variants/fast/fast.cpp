@@ -227,8 +227,9 @@ public:
         for (const auto* arr : {&id_, &pos_, &tmpi_, &pstart_, &partner_, &owner_, &lstart_, &lslot_, &cstart_})
             b += arr->capacity() * sizeof(Index);
         b += slot_.capacity() * sizeof(Slot<T>) + coef_.capacity() * sizeof(Coefficients<T>) + touch_.capacity() + near_wall_.capacity();
-        b += key_.capacity() * sizeof(key_[0]) + cell3_.capacity() * sizeof(std::int64_t);
+        b += (key_.capacity() + keytmp_.capacity()) * sizeof(Key) + cell3_.capacity() * sizeof(std::int64_t);
         for (const auto& f : foreign_) b += f.capacity() * sizeof(Foreign<T>);
+        for (const auto& v : scan_) b += v.capacity() * sizeof(Index);
         return b;
     }
 
