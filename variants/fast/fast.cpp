@@ -13,14 +13,18 @@
 //   §6, the slots where it is j (partners of lower id, ascending; a list also kept across steps), then
 //   its own slots (partners of higher id, ascending, contiguous), then its walls, and applies Newton's
 //   law. No sum depends on which thread did what, so the bits do not depend on the thread count.
+// - The kernel reads each particle's position, radius, velocity and angular velocity from one record
+//   (Kin, refreshed at the start of the force pass) and moves a pack's worth between records and lanes
+//   by transposes of whole vectors.
 // - FastOptions::canonical = false drops the canonical order: each pair's force is added to both
-//   particles as it is computed (a thread adds to the particles of its own range directly and queues
-//   those of another thread's range, applied after a barrier), which is what an unordered code does.
+//   particles as it is computed, into per-thread loads summed after a barrier, which is what an
+//   unordered code does; it keeps no slots.
 #include "fast.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstring>
 #include <utility>
 #include <vector>
 
@@ -57,12 +61,99 @@ struct Slot {
     Vec3<T> f, ti, tj;
 };
 
-// A contribution for a particle in another thread's range (unordered mode only).
+// Four values loaded and stored as one vector (32 bytes for double): the unit of the kernel's transposes.
 template <class T>
-struct Foreign {
-    Index q;
-    Vec3<T> f, t;
+using Quad = Pack<T, 4>;
+
+// A particle's kinematics as the pair kernel reads them, one record per particle (refreshed at the start
+// of each force pass): position and radius, velocity, angular velocity, a quad each, so that a lane's
+// particle is three loads of one record, not ten from ten arrays.
+template <class T>
+struct alignas(sizeof(Quad<T>)) Kin {
+    Quad<T> xr;  // x, y, z, R
+    Quad<T> v;   // vx, vy, vz, 0
+    Quad<T> w;   // wx, wy, wz, 0
 };
+
+// A listed pair's law coefficients, padded to a quad (kn, cn, ct, 0).
+template <class T>
+struct alignas(sizeof(Quad<T>)) PairCoefficients {
+    Quad<T> k;
+};
+
+// A particle's force and torque summed in storage order (unordered mode), one cache line for double.
+template <class T>
+struct alignas(2 * sizeof(Quad<T>)) Load {
+    Quad<T> f;  // fx, fy, fz, (unused)
+    Quad<T> t;  // tx, ty, tz, (unused)
+};
+
+// In-place transpose of a 4×4 block: afterwards a[c] holds what was lane c of the four, and so on.
+template <class T>
+inline void transpose4(Quad<T>& a, Quad<T>& b, Quad<T>& c, Quad<T>& d)
+{
+    const Quad<T> t0 = __builtin_shufflevector(a, b, 0, 4, 2, 6), t1 = __builtin_shufflevector(a, b, 1, 5, 3, 7);
+    const Quad<T> t2 = __builtin_shufflevector(c, d, 0, 4, 2, 6), t3 = __builtin_shufflevector(c, d, 1, 5, 3, 7);
+    a = __builtin_shufflevector(t0, t2, 0, 1, 4, 5);
+    b = __builtin_shufflevector(t1, t3, 0, 1, 4, 5);
+    c = __builtin_shufflevector(t0, t2, 2, 3, 6, 7);
+    d = __builtin_shufflevector(t1, t3, 2, 3, 6, 7);
+}
+
+// rows[l] is lane l's quad; out[c][l] = rows[l][c]. A transpose of whole vectors (a few shuffles per
+// pack) instead of one scalar load and one lane insert per value. Moves bits, computes nothing.
+template <class V>
+inline void rows_to_lanes(const Quad<LaneScalar<V>>* rows, V out[4])
+{
+    using T = LaneScalar<V>;
+    constexpr int W = lane_count<V>;
+    if constexpr (W == 8 || W == 4) {
+        Quad<T> r[W];
+        for (int l = 0; l < W; ++l) r[l] = rows[l];
+        transpose4<T>(r[0], r[1], r[2], r[3]);
+        if constexpr (W == 8) {
+            transpose4<T>(r[4], r[5], r[6], r[7]);
+            for (int c = 0; c < 4; ++c) out[c] = __builtin_shufflevector(r[c], r[4 + c], 0, 1, 2, 3, 4, 5, 6, 7);
+        } else {
+            for (int c = 0; c < 4; ++c) out[c] = r[c];
+        }
+    } else if constexpr (W == 2) {
+        out[0] = __builtin_shufflevector(rows[0], rows[1], 0, 4);
+        out[1] = __builtin_shufflevector(rows[0], rows[1], 1, 5);
+        out[2] = __builtin_shufflevector(rows[0], rows[1], 2, 6);
+        out[3] = __builtin_shufflevector(rows[0], rows[1], 3, 7);
+    } else {
+        for (int c = 0; c < 4; ++c)
+            for (int l = 0; l < W; ++l) out[c][l] = rows[l][c];
+    }
+}
+
+// The inverse: rows[l] = {in[0][l], in[1][l], in[2][l], in[3][l]}.
+template <class V>
+inline void lanes_to_rows(const V in[4], Quad<LaneScalar<V>>* rows)
+{
+    using T = LaneScalar<V>;
+    constexpr int W = lane_count<V>;
+    if constexpr (W == 8) {
+        Quad<T> lo[4], hi[4];
+        for (int c = 0; c < 4; ++c) {
+            lo[c] = __builtin_shufflevector(in[c], in[c], 0, 1, 2, 3);
+            hi[c] = __builtin_shufflevector(in[c], in[c], 4, 5, 6, 7);
+        }
+        transpose4<T>(lo[0], lo[1], lo[2], lo[3]);
+        transpose4<T>(hi[0], hi[1], hi[2], hi[3]);
+        for (int l = 0; l < 4; ++l) {
+            rows[l] = lo[l];
+            rows[4 + l] = hi[l];
+        }
+    } else if constexpr (W == 4) {
+        Quad<T> r[4] = {in[0], in[1], in[2], in[3]};
+        transpose4<T>(r[0], r[1], r[2], r[3]);
+        for (int l = 0; l < 4; ++l) rows[l] = r[l];
+    } else {
+        for (int l = 0; l < W; ++l) rows[l] = Quad<T>{in[0][l], in[1][l], in[2][l], in[3][l]};
+    }
+}
 
 template <class T, class M>
 class Fast final : public FastVariant {
@@ -105,6 +196,7 @@ public:
         place_walls(step_);
         pstart_.assign(n_ + 1, 0);
         near_wall_.assign(n_, 0);
+        kin_.resize(n_);
         lstart_.assign(n_ + 1, 0);
         key_.resize(n_);
         rebuilds_ = 0;
@@ -226,9 +318,10 @@ public:
             b += arr->capacity() * sizeof(T);
         for (const auto* arr : {&id_, &pos_, &tmpi_, &pstart_, &partner_, &owner_, &lstart_, &lslot_, &cstart_})
             b += arr->capacity() * sizeof(Index);
-        b += slot_.capacity() * sizeof(Slot<T>) + coef_.capacity() * sizeof(Coefficients<T>) + touch_.capacity() + near_wall_.capacity();
+        b += slot_.capacity() * sizeof(Slot<T>) + pcoef_.capacity() * sizeof(PairCoefficients<T>) + touch_.capacity() + near_wall_.capacity();
+        b += kin_.capacity() * sizeof(Kin<T>);
         b += (key_.capacity() + keytmp_.capacity()) * sizeof(Key) + cell3_.capacity() * sizeof(std::int64_t);
-        for (const auto& f : foreign_) b += f.capacity() * sizeof(Foreign<T>);
+        for (const auto& l : loads_) b += l.capacity() * sizeof(Load<T>);
         for (const auto& v : scan_) b += v.capacity() * sizeof(Index);
         return b;
     }
@@ -259,84 +352,133 @@ private:
     static constexpr int kLanes = native_lanes<T>;
     static constexpr std::size_t kBlock = 512;
 
-    // Slots [k0, k1) (owner s, partner q; id(s) < id(q)): touch[k] says whether the pair is in contact,
-    // and then slot[k] holds its contact. A canonical sum reads every slot of a particle, so there a pair
-    // out of contact holds zeros, which add nothing (a sum that starts at +0 is never -0, and x + ±0 = x for every other
-    // x), so the bits are those of arrays, which skips the pair; reading zeros costs less than a branch
-    // that is taken at random. may_touch first, a cheap and conservative test (the law rejects every pair
-    // it rejects), so the skin's extra candidates cost a distance, not a pass through the law; the rest go
-    // through the law kLanes at a time. The test sorts the slots into kept and dropped without a branch
-    // (a third are dropped, in no pattern a predictor learns). Returns the contacts found.
-    std::int64_t slots_of(std::size_t k0, std::size_t k1)
+    // Slots [k0, k1) (owner s, partner q): the contacts among them, each into its slot (canonical mode,
+    // where touch[k] then says whether slot k holds a contact) or added to the loads `load` of both
+    // particles (unordered mode). A canonical sum reads every slot of a particle, so there a pair out of
+    // contact holds zeros, which add nothing (a sum that starts at +0 is never -0, and x + ±0 = x for
+    // every other x), so the bits are those of arrays, which skips the pair; reading zeros costs less than
+    // a branch that is taken at random. may_touch first, a cheap and conservative test (the law rejects
+    // every pair it rejects), so the skin's extra candidates cost a distance, not a pass through the law;
+    // the rest go through the law kLanes at a time. The test sorts the slots into kept and dropped
+    // without a branch (a third are dropped, in no pattern a predictor learns). Returns the contacts found.
+    std::int64_t slots_of(std::size_t k0, std::size_t k1, Load<T>* load)
     {
         const Index* owner = owner_.data();
         const Index* partner = partner_.data();
-        const T* x = x_.data();
-        const T* r = r_.data();
-        const std::size_t n = n_;
+        const Kin<T>* kin = kin_.data();
         std::size_t kept[kBlock], dropped[kBlock];
         std::int64_t found = 0;
         for (std::size_t c0 = k0; c0 < k1; c0 += kBlock) {
             const std::size_t c1 = std::min(k1, c0 + kBlock);
             std::size_t nk = 0, nd = 0;
             for (std::size_t k = c0; k < c1; ++k) {
-                const std::size_t s = std::size_t(owner[k]), q = std::size_t(partner[k]);
-                const bool t = may_touch(Vec3<T>{x[s], x[n + s], x[2 * n + s]}, Vec3<T>{x[q], x[n + q], x[2 * n + q]}, r[s], r[q]);
+                const Quad<T> a = kin[owner[k]].xr, b = kin[partner[k]].xr;
+                const bool t = may_touch(Vec3<T>{a[0], a[1], a[2]}, Vec3<T>{b[0], b[1], b[2]}, a[3], b[3]);
                 kept[nk] = k;
                 dropped[nd] = k;
                 nk += std::size_t(t);
                 nd += std::size_t(!t);
             }
             // A dropped slot is zeroed when it was not dropped the step before (most stay dropped).
-            for (std::size_t e = 0; e < nd; ++e) {
-                const std::size_t k = dropped[e];
-                if (!touch_[k]) continue;
-                touch_[k] = 0;
-                if (opt_.canonical) slot_[k] = Slot<T>{};
-            }
-            for (std::size_t e = 0; e < nk; e += kLanes) found += pack_of_slots(kept + e, int(std::min<std::size_t>(kLanes, nk - e)));
+            if (opt_.canonical)
+                for (std::size_t e = 0; e < nd; ++e) {
+                    const std::size_t k = dropped[e];
+                    if (!touch_[k]) continue;
+                    touch_[k] = 0;
+                    slot_[k] = Slot<T>{};
+                }
+            for (std::size_t e = 0; e < nk; e += kLanes) found += pack_of_slots(kept + e, int(std::min<std::size_t>(kLanes, nk - e)), load);
         }
         return found;
     }
 
     // The law for up to kLanes slots at once (unused lanes repeat the last slot and are not stored):
-    // gather both particles of each slot and the pair's coefficients (computed when it was listed) into
-    // the lanes, run particle_contact_lanes, scatter the lanes back into the slots (zeros where h <= 0).
-    // Each lane's bits are those particle_contact gives for its slot's pair.
-    int pack_of_slots(const std::size_t* ks, int count)
+    // both particles' records and the pair's coefficients (computed when it was listed) transposed into
+    // the lanes, particle_contact_lanes, and the lanes transposed back into the slots (zeros where
+    // h <= 0) or added to the loads. Each lane's bits are those particle_contact gives for its slot's pair.
+    int pack_of_slots(const std::size_t* ks, int count, Load<T>* load)
     {
-        Vec3<Lanes> xi, xj, vi, vj, wi, wj;
-        Lanes ri{}, rj{};
-        Coefficients<Lanes> kc;
-        const std::size_t n = n_;
+        std::size_t k[kLanes], s[kLanes], q[kLanes];
         for (int l = 0; l < kLanes; ++l) {
-            const std::size_t k = ks[l < count ? l : count - 1];
-            const std::size_t s = std::size_t(owner_[k]), q = std::size_t(partner_[k]);
-            xi.x[l] = x_[s]; xi.y[l] = x_[n + s]; xi.z[l] = x_[2 * n + s];
-            xj.x[l] = x_[q]; xj.y[l] = x_[n + q]; xj.z[l] = x_[2 * n + q];
-            vi.x[l] = v_[s]; vi.y[l] = v_[n + s]; vi.z[l] = v_[2 * n + s];
-            vj.x[l] = v_[q]; vj.y[l] = v_[n + q]; vj.z[l] = v_[2 * n + q];
-            wi.x[l] = w_[s]; wi.y[l] = w_[n + s]; wi.z[l] = w_[2 * n + s];
-            wj.x[l] = w_[q]; wj.y[l] = w_[n + q]; wj.z[l] = w_[2 * n + q];
-            ri[l] = r_[s]; rj[l] = r_[q];
-            kc.kn[l] = coef_[k].kn; kc.cn[l] = coef_[k].cn; kc.ct[l] = coef_[k].ct;
+            k[l] = ks[l < count ? l : count - 1];
+            s[l] = std::size_t(owner_[k[l]]);
+            q[l] = std::size_t(partner_[k[l]]);
         }
+        Quad<T> rows[kLanes];
+        Lanes xi[4], xj[4], vi[4], vj[4], wi[4], wj[4], kc[4];
+        const Kin<T>* kin = kin_.data();
+        auto lanes = [&](auto&& row, Lanes* out) {
+            for (int l = 0; l < kLanes; ++l) rows[l] = row(l);
+            rows_to_lanes<Lanes>(rows, out);
+        };
+        lanes([&](int l) { return kin[s[l]].xr; }, xi);
+        lanes([&](int l) { return kin[q[l]].xr; }, xj);
+        lanes([&](int l) { return kin[s[l]].v; }, vi);
+        lanes([&](int l) { return kin[q[l]].v; }, vj);
+        if constexpr (M::rotation) {
+            lanes([&](int l) { return kin[s[l]].w; }, wi);
+            lanes([&](int l) { return kin[q[l]].w; }, wj);
+        }
+        lanes([&](int l) { return pcoef_[k[l]].k; }, kc);
         ContactForce<Lanes> c;
         // (The masses only enter the coefficients, so the law does not read them here.)
-        const auto touch = particle_contact_lanes<CoefficientsGiven<M>>(xi, xj, vi, vj, wi, wj, ri, rj, Lanes{}, Lanes{}, params_, kc, c);
+        const auto touch = particle_contact_lanes<CoefficientsGiven<M>>(
+            Vec3<Lanes>{xi[0], xi[1], xi[2]}, Vec3<Lanes>{xj[0], xj[1], xj[2]}, Vec3<Lanes>{vi[0], vi[1], vi[2]},
+            Vec3<Lanes>{vj[0], vj[1], vj[2]}, Vec3<Lanes>{wi[0], wi[1], wi[2]}, Vec3<Lanes>{wj[0], wj[1], wj[2]}, xi[3], xj[3], Lanes{},
+            Lanes{}, params_, Coefficients<Lanes>{kc[0], kc[1], kc[2]}, c);
         int found = 0;
-        for (int l = 0; l < count; ++l) {
-            const std::size_t k = ks[l];
-            touch_[k] = std::uint8_t(touch[l] != 0);
-            found += touch_[k];
-            Slot<T>& out = slot_[k];
-            out.f = {c.f_i.x[l], c.f_i.y[l], c.f_i.z[l]};
+        for (int l = 0; l < count; ++l) found += int(touch[l] != 0);
+        if (opt_.canonical) {
+            // A slot is nine values: f, t_i, t_j; the first eight go as two quads, the ninth alone.
+            static_assert(sizeof(Slot<T>) == 9 * sizeof(T));
+            const Lanes g0[4] = {c.f_i.x, c.f_i.y, c.f_i.z, c.t_i.x}, g1[4] = {c.t_i.y, c.t_i.z, c.t_j.x, c.t_j.y};
+            Quad<T> r0[kLanes], r1[kLanes];
+            lanes_to_rows<Lanes>(g0, r0);
+            lanes_to_rows<Lanes>(g1, r1);
+            for (int l = 0; l < count; ++l) {
+                touch_[k[l]] = std::uint8_t(touch[l] != 0);
+                char* out = reinterpret_cast<char*>(&slot_[k[l]]);
+                std::memcpy(out, &r0[l], sizeof(Quad<T>));
+                std::memcpy(out + sizeof(Quad<T>), &r1[l], sizeof(Quad<T>));
+                slot_[k[l]].tj.z = c.t_j.z[l];
+            }
+        } else {
+            // Added as they come, lane by lane (a particle may sit in several lanes).
+            const Lanes zero{};
+            const Lanes gf[4] = {c.f_i.x, c.f_i.y, c.f_i.z, zero}, gi[4] = {c.t_i.x, c.t_i.y, c.t_i.z, zero},
+                        gj[4] = {c.t_j.x, c.t_j.y, c.t_j.z, zero};
+            Quad<T> f[kLanes], ti[kLanes], tj[kLanes];
+            lanes_to_rows<Lanes>(gf, f);
             if constexpr (M::rotation) {
-                out.ti = {c.t_i.x[l], c.t_i.y[l], c.t_i.z[l]};
-                out.tj = {c.t_j.x[l], c.t_j.y[l], c.t_j.z[l]};
+                lanes_to_rows<Lanes>(gi, ti);
+                lanes_to_rows<Lanes>(gj, tj);
+            }
+            for (int l = 0; l < count; ++l) {
+                load[s[l]].f += f[l];
+                load[q[l]].f -= f[l];
+                if constexpr (M::rotation) {
+                    load[s[l]].t += ti[l];
+                    load[q[l]].t += tj[l];
+                }
             }
         }
         return found;
+    }
+
+    // The kernel's per-particle records for [lo, hi), from the state arrays.
+    void refresh_kin(std::size_t lo, std::size_t hi)
+    {
+        const std::size_t n = n_;
+        const T* __restrict x = x_.data();
+        const T* __restrict v = v_.data();
+        const T* __restrict w = w_.data();
+        const T* __restrict r = r_.data();
+        Kin<T>* __restrict kin = kin_.data();
+        for (std::size_t s = lo; s < hi; ++s) {
+            kin[s].xr = Quad<T>{x[s], x[n + s], x[2 * n + s], r[s]};
+            kin[s].v = Quad<T>{v[s], v[n + s], v[2 * n + s], T(0)};
+            kin[s].w = Quad<T>{w[s], w[n + s], w[2 * n + s], T(0)};
+        }
     }
 
     void forces_canonical()
@@ -351,12 +493,14 @@ private:
         const std::size_t total = partner_.size(), blocks = (total + kBlock - 1) / kBlock;
 #pragma omp parallel reduction(+ : pp, pw) if (par_)
         {
+            const auto [lo, hi] = thread_range(n);
+            refresh_kin(lo, hi);
+#pragma omp barrier
             // Every contact once, into its slot, a pack of candidates at a time.
 #pragma omp for schedule(static)
-            for (std::size_t b = 0; b < blocks; ++b) pp += slots_of(b * kBlock, std::min(total, (b + 1) * kBlock));
+            for (std::size_t b = 0; b < blocks; ++b) pp += slots_of(b * kBlock, std::min(total, (b + 1) * kBlock), nullptr);
             // Each particle's sum in the canonical order: as j (partners of lower id, ascending), as i
             // (partners of higher id, ascending), its walls in wall order; then Newton.
-            const auto [lo, hi] = thread_range(n);
             mark_walls(lo, hi);
             for (std::size_t s = lo; s < hi; ++s) {
                 Vec3<T> F{}, Tq{};
@@ -430,60 +574,42 @@ private:
         if constexpr (M::rotation) put(alc_, s, {Tq.x / I_[s], Tq.y / I_[s], Tq.z / I_[s]});
     }
 
-    void add(std::vector<T>& a, std::size_t s, const Vec3<T>& v)
-    {
-        a[s] += v.x;
-        a[n_ + s] += v.y;
-        a[2 * n_ + s] += v.z;
-    }
-
+    // Unordered: each pair's force added to both particles as the pack computes it, into loads of the
+    // thread's own (zeroed over the span of particles its slots reach, set at the rebuild), then each
+    // particle's loads summed over the threads whose span holds it, in thread order, and its walls.
     void forces_unordered()
     {
         const std::size_t n = n_;
-        const int limit = thread_limit();
-        if (foreign_.size() < std::size_t(limit)) foreign_.resize(std::size_t(limit));
+        const std::size_t limit = std::size_t(thread_limit());
+        if (loads_.size() < limit) loads_.resize(limit);
         std::int64_t pp = 0, pw = 0;
 #pragma omp parallel reduction(+ : pp, pw) if (par_)
         {
             const std::size_t nt = std::size_t(thread_count()), t = std::size_t(thread_index());
             const auto [lo, hi] = thread_range(n);
-            for (std::size_t s = lo; s < hi; ++s) {
-                put(f_, s, {});
-                put(t_, s, {});
-            }
-            std::vector<Foreign<T>>& queue = foreign_[t];
-            queue.clear();
-            // The contacts of this thread's particles, a pack at a time, then added up as they come.
-            pp += slots_of(std::size_t(pstart_[lo]), std::size_t(pstart_[hi]));
+            // A thread count other than the rebuild's (no rebuild since it changed): every thread zeroes all.
+            const bool spans_known = span_threads_ == nt;
+            std::vector<Load<T>>& mine = loads_[t];
+            if (mine.size() != n) mine.resize(n);
+            const auto [z0, z1] = spans_known ? spans_[t] : std::pair<std::size_t, std::size_t>{0, n};
+            std::fill(mine.begin() + std::ptrdiff_t(z0), mine.begin() + std::ptrdiff_t(z1), Load<T>{});
+            refresh_kin(lo, hi);
             mark_walls(lo, hi);
 #pragma omp barrier
-            for (std::size_t s = lo; s < hi; ++s) {
-                Vec3<T> F{}, Tq{};
-                for (Index k = pstart_[s]; k < pstart_[s + 1]; ++k) {
-                    if (!touch_[std::size_t(k)]) continue;  // not in contact: nothing to add, no write to the partner
-                    const std::size_t q = std::size_t(partner_[k]);
-                    const Slot<T>& c = slot_[std::size_t(k)];
-                    F += c.f;
-                    if constexpr (M::rotation) Tq += c.ti;
-                    if (q >= lo && q < hi) {
-                        add(f_, q, -c.f);
-                        if constexpr (M::rotation) add(t_, q, c.tj);
-                    } else {
-                        queue.push_back({Index(q), -c.f, c.tj});
-                    }
-                }
-                if (near_wall_[s]) pw += walls_of(s, F, Tq);
-                add(f_, s, F);
-                add(t_, s, Tq);
-            }
+            pp += slots_of(std::size_t(pstart_[lo]), std::size_t(pstart_[hi]), mine.data());
 #pragma omp barrier
-            for (std::size_t u = 0; u < nt; ++u)
-                for (const Foreign<T>& e : foreign_[u])
-                    if (std::size_t(e.q) >= lo && std::size_t(e.q) < hi) {
-                        add(f_, std::size_t(e.q), e.f);
-                        if constexpr (M::rotation) add(t_, std::size_t(e.q), e.t);
-                    }
-            for (std::size_t s = lo; s < hi; ++s) finish(s, get(f_, s), get(t_, s));
+            for (std::size_t s = lo; s < hi; ++s) {
+                Quad<T> f{}, tq{};
+                for (std::size_t u = 0; u < nt; ++u) {
+                    const auto [u0, u1] = spans_known ? spans_[u] : std::pair<std::size_t, std::size_t>{0, n};
+                    if (s < u0 || s >= u1) continue;
+                    f += loads_[u][s].f;
+                    tq += loads_[u][s].t;
+                }
+                Vec3<T> F{f[0], f[1], f[2]}, Tq{tq[0], tq[1], tq[2]};
+                if (near_wall_[s]) pw += walls_of(s, F, Tq);
+                finish(s, F, Tq);
+            }
         }
         pp_ = pp;
         pw_ = pw;
@@ -644,13 +770,24 @@ private:
                 total = std::size_t(pstart[n]);
                 partner_.resize(total);
                 owner_.resize(total);
-                slot_.resize(total);
-                touch_.assign(total, 1);  // "maybe in contact": the first pass zeroes the slots it drops
-                coef_.resize(total);
+                if (canonical) {
+                    slot_.resize(total);
+                    touch_.assign(total, 1);  // "maybe in contact": the first pass zeroes the slots it drops
+                }
+                pcoef_.resize(total);
+                spans_.resize(std::size_t(thread_count()));
+                span_threads_ = std::size_t(thread_count());
             }
             Index* partner = partner_.data();
             Index* owner = owner_.data();
             std::copy(mine.begin(), mine.end(), partner + pstart[lo]);
+            // The particles this thread's slots reach (unordered mode's loads): its own and its partners.
+            std::size_t span_lo = lo, span_hi = hi;
+            for (const Index q : mine) {
+                span_lo = std::min(span_lo, std::size_t(q));
+                span_hi = std::max(span_hi, std::size_t(q) + 1);
+            }
+            spans_[std::size_t(thread_index())] = {span_lo, span_hi};
             for (std::size_t s = lo; s < hi; ++s) {
                 std::fill(owner + pstart[s], owner + pstart[s + 1], Index(s));
                 // Canonical: partners by ascending id. Unordered: the scan's order (ascending storage).
@@ -659,7 +796,8 @@ private:
                 // The law's coefficients of each listed pair (i = s, the lower id), once per rebuild.
                 for (Index e = pstart[s]; e < pstart[s + 1]; ++e) {
                     const std::size_t q = std::size_t(partner[e]);
-                    coef_[std::size_t(e)] = pair_coefficients(r_[s], r_[q], m_[s], m_[q], params_);
+                    const Coefficients<T> k = pair_coefficients(r_[s], r_[q], m_[s], m_[q], params_);
+                    pcoef_[std::size_t(e)].k = Quad<T>{k.kn, k.cn, k.ct, T(0)};
                 }
             }
         }
@@ -699,15 +837,18 @@ private:
     // The neighbour list: pairs of s in [pstart[s], pstart[s+1]), one slot each; where s is the partner.
     std::vector<Index> pstart_, partner_, owner_, lstart_, lslot_;
     std::vector<Slot<T>> slot_;
-    std::vector<Coefficients<T>> coef_;     // each listed pair's law coefficients (pair_coefficients)
-    std::vector<std::uint8_t> touch_;       // each listed pair: in contact this step (then slot_ holds it)
+    std::vector<PairCoefficients<T>> pcoef_;  // each listed pair's law coefficients (pair_coefficients)
+    std::vector<std::uint8_t> touch_;         // each listed pair: in contact this step (then slot_ holds it; canonical)
+    std::vector<Kin<T>> kin_;                 // (N) the kernel's copy of x, R, v, ω
     std::vector<std::uint8_t> near_wall_;   // (N) may touch a wall this step
     std::vector<Key> key_, keytmp_;
     std::vector<std::int64_t> cell3_;  // (3N) cell coordinates at the last rebuild
     std::vector<Index> cstart_;        // first storage slot of each cell (dense grid), cells + 1
     bool dense_ = true;
     std::int64_t dims_[2] = {0, 0};
-    std::vector<std::vector<Foreign<T>>> foreign_;  // per thread (unordered mode)
+    std::vector<std::vector<Load<T>>> loads_;                // per thread: loads in storage order (unordered mode)
+    std::vector<std::pair<std::size_t, std::size_t>> spans_;  // per thread: the storage range its slots reach
+    std::size_t span_threads_ = 0;                            // the thread count spans_ is for
     std::vector<std::vector<Index>> scan_;          // per thread: partners found by list_pairs' scan
     std::int64_t pp_ = 0, pw_ = 0;
 };
