@@ -257,3 +257,86 @@ TEST(ContactLaw, EveryLaneOfAPackHasTheScalarLawsBits)
     check_lanes_against_scalar<FullModel, double, native_lanes<double>, true>();
     check_lanes_against_scalar<FullModel, float, native_lanes<float>, true>();
 }
+
+namespace {
+
+// The particle–wall law on packs, lane by lane against the scalar law, bit for bit: random particles
+// around random walls (each lane its own wall, as the fast variant packs them), half of them touching,
+// moving walls, no tangential motion, fast separation (clipped), sliding and sticking.
+template <class M, class T, int W>
+void check_wall_lanes_against_scalar()
+{
+    using V = Pack<T, W>;
+    const ContactParams<T> p{T(4e5), T(6e5), T(60), T(60), T(0.6)};
+    const Coefficients<T> mono = wall_coefficients(T(1e-3), T(1e-6), p);
+    const Coefficients<V> mono_lanes{splat<V>(mono.kn), splat<V>(mono.cn), splat<V>(mono.ct)};
+    std::mt19937_64 rng(2024);
+    std::uniform_real_distribution<double> u(-1.0, 1.0), pos(0.5, 1.5);
+    auto vec = [&](double s) { return Vec3<T>{T(s * u(rng)), T(s * u(rng)), T(s * u(rng))}; };
+    int touching = 0, clipped = 0;
+    for (int b = 0; b < 64; ++b) {
+        Vec3<T> x[W], v[W], w[W], point[W], normal[W], vw[W];
+        T r[W], m[W];
+        Vec3<V> xl, vl, wl, pl, nl, vwl;
+        V rl{}, ml{};
+        for (int l = 0; l < W; ++l) {
+            r[l] = T(1e-3 * pos(rng));
+            m[l] = T(1e-6 * pos(rng));
+            const Vec3<T> dir = vec(1.0);
+            normal[l] = T(1.0 / std::sqrt(double(dot(dir, dir)))) * dir;
+            point[l] = vec(0.1);
+            // Distance to the plane from 0.9 to 1.1 of R: about half touch.
+            const Vec3<T> along = vec(1e-3);  // an offset along the plane
+            x[l] = point[l] + T(double(r[l]) * (1.0 + 0.1 * u(rng))) * normal[l] + (along - dot(along, normal[l]) * normal[l]);
+            vw[l] = l % 2 ? vec(0.1) : Vec3<T>{};
+            switch ((b * W + l) % 4) {
+            case 0: v[l] = vw[l]; w[l] = {}; break;                      // no relative motion: u_t = 0
+            case 1: v[l] = T(50) * normal[l]; w[l] = vec(10.0); break;  // leaving fast: F_n clipped to zero
+            default: v[l] = vec(1.0); w[l] = vec(100.0);
+            }
+            for (int c = 0; c < 3; ++c) {
+                component(xl, c)[l] = component(x[l], c);
+                component(vl, c)[l] = component(v[l], c);
+                component(wl, c)[l] = component(w[l], c);
+                component(pl, c)[l] = component(point[l], c);
+                component(nl, c)[l] = component(normal[l], c);
+                component(vwl, c)[l] = component(vw[l], c);
+            }
+            rl[l] = r[l];
+            ml[l] = m[l];
+        }
+        ContactForce<V> lanes;
+        const auto touch = wall_contact_lanes<M>(xl, vl, wl, rl, ml, pl, nl, vwl, p, mono_lanes, lanes);
+        for (int l = 0; l < W; ++l) {
+            ContactForce<T> one;
+            const bool hit = wall_contact<M>(x[l], v[l], w[l], r[l], m[l], point[l], normal[l], vw[l], p, mono, one);
+            ASSERT_EQ(hit, touch[l] != 0) << "sample " << b << ", lane " << l;
+            if (!hit) one = ContactForce<T>{};
+            touching += hit;
+            clipped += hit && one.f_i.x == T(0) && one.f_i.y == T(0) && one.f_i.z == T(0);
+            const Vec3<T>* want[2] = {&one.f_i, &one.t_i};
+            const Vec3<V>* got[2] = {&lanes.f_i, &lanes.t_i};
+            for (int q = 0; q < (M::rotation ? 2 : 1); ++q)
+                for (int c = 0; c < 3; ++c)
+                    ASSERT_TRUE(same_bits(component(*want[q], c), component(*got[q], c)[l]))
+                        << "sample " << b << ", lane " << l << ", quantity " << q << ", component " << c << ": scalar "
+                        << component(*want[q], c) << ", lane " << component(*got[q], c)[l];
+        }
+    }
+    EXPECT_GT(touching, 64 * W / 4);
+    EXPECT_LT(touching, 64 * W * 3 / 4);
+    if constexpr (M::damping) {
+        EXPECT_GT(clipped, 0);
+    }
+}
+
+} // namespace
+
+TEST(ContactLaw, EveryLaneOfAWallPackHasTheScalarLawsBits)
+{
+    check_wall_lanes_against_scalar<FullModel, double, native_lanes<double>>();
+    check_wall_lanes_against_scalar<FullModel, float, native_lanes<float>>();
+    check_wall_lanes_against_scalar<Model<true, true, true, true, true, false>, double, native_lanes<double>>();  // monodisperse
+    check_wall_lanes_against_scalar<Model<false, false, false>, double, native_lanes<double>>();                 // normal force only
+    check_wall_lanes_against_scalar<FullModel, double, 2 * native_lanes<double>>();
+}

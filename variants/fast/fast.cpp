@@ -71,8 +71,19 @@ using Quad = Pack<T, 4>;
 template <class T>
 struct alignas(sizeof(Quad<T>)) Kin {
     Quad<T> xr;  // x, y, z, R
-    Quad<T> v;   // vx, vy, vz, 0
+    Quad<T> v;   // vx, vy, vz, m (the mass: the wall law's coefficients)
     Quad<T> w;   // wx, wy, wz, 0
+};
+
+// A wall as the wall kernel reads it: point (where it is this step), unit normal, velocity.
+template <class T>
+struct alignas(sizeof(Quad<T>)) WallRecord {
+    Quad<T> p, n, v;  // (x, y, z, 0) each
+};
+
+// A particle–wall pair that may touch this step.
+struct WallCandidate {
+    std::int32_t s, w;  // storage slot of the particle, wall index
 };
 
 // A listed pair's law coefficients, padded to a quad (kn, cn, ct, 0).
@@ -187,11 +198,11 @@ public:
             I_[i] = T(setup.inertia[i]);
             id_[i] = Index(i);
         }
-        wp_.assign(3 * nw_, T(0)); wn_.assign(3 * nw_, T(0)); wv_.assign(3 * nw_, T(0));
+        wall_rec_.assign(nw_, WallRecord<T>{});
         for (std::size_t w = 0; w < nw_; ++w)
             for (int c = 0; c < 3; ++c) {
-                wn_[3 * w + c] = T(component(walls_[w].normal, c));
-                wv_[3 * w + c] = T(component(walls_[w].velocity, c));
+                wall_rec_[w].n[c] = T(component(walls_[w].normal, c));
+                wall_rec_[w].v[c] = T(component(walls_[w].velocity, c));
             }
         place_walls(step_);
         pstart_.assign(n_ + 1, 0);
@@ -322,6 +333,8 @@ public:
         b += kin_.capacity() * sizeof(Kin<T>);
         b += (key_.capacity() + keytmp_.capacity()) * sizeof(Key) + cell3_.capacity() * sizeof(std::int64_t);
         for (const auto& l : loads_) b += l.capacity() * sizeof(Load<T>);
+        for (const auto& l : wall_res_) b += l.capacity() * sizeof(Load<T>);
+        for (const auto& l : wall_cand_) b += l.capacity() * sizeof(WallCandidate);
         for (const auto& v : scan_) b += v.capacity() * sizeof(Index);
         return b;
     }
@@ -334,15 +347,14 @@ private:
         a[n_ + s] = v.y;
         a[2 * n_ + s] = v.z;
     }
-    Vec3<T> wall_point(std::size_t w) const { return {wp_[3 * w], wp_[3 * w + 1], wp_[3 * w + 2]}; }
-    Vec3<T> wall_normal(std::size_t w) const { return {wn_[3 * w], wn_[3 * w + 1], wn_[3 * w + 2]}; }
-    Vec3<T> wall_velocity(std::size_t w) const { return {wv_[3 * w], wv_[3 * w + 1], wv_[3 * w + 2]}; }
+    Vec3<T> wall_point(std::size_t w) const { return {wall_rec_[w].p[0], wall_rec_[w].p[1], wall_rec_[w].p[2]}; }
+    Vec3<T> wall_normal(std::size_t w) const { return {wall_rec_[w].n[0], wall_rec_[w].n[1], wall_rec_[w].n[2]}; }
 
     void place_walls(std::int64_t step)
     {
         for (std::size_t w = 0; w < nw_; ++w) {
             const Vec3d p = walls_[w].point_at(step, dt_);
-            for (int c = 0; c < 3; ++c) wp_[3 * w + c] = T(component(p, c));
+            for (int c = 0; c < 3; ++c) wall_rec_[w].p[c] = T(component(p, c));
         }
     }
 
@@ -405,7 +417,7 @@ private:
             q[l] = std::size_t(partner_[k[l]]);
         }
         Quad<T> rows[kLanes];
-        Lanes xi[4], xj[4], vi[4], vj[4], wi[4], wj[4], kc[4];
+        Lanes xi[4]{}, xj[4]{}, vi[4]{}, vj[4]{}, wi[4]{}, wj[4]{}, kc[4]{};
         const Kin<T>* kin = kin_.data();
         auto lanes = [&](auto&& row, Lanes* out) {
             for (int l = 0; l < kLanes; ++l) rows[l] = row(l);
@@ -473,10 +485,11 @@ private:
         const T* __restrict v = v_.data();
         const T* __restrict w = w_.data();
         const T* __restrict r = r_.data();
+        const T* __restrict m = m_.data();
         Kin<T>* __restrict kin = kin_.data();
         for (std::size_t s = lo; s < hi; ++s) {
             kin[s].xr = Quad<T>{x[s], x[n + s], x[2 * n + s], r[s]};
-            kin[s].v = Quad<T>{v[s], v[n + s], v[2 * n + s], T(0)};
+            kin[s].v = Quad<T>{v[s], v[n + s], v[2 * n + s], m[s]};
             kin[s].w = Quad<T>{w[s], w[n + s], w[2 * n + s], T(0)};
         }
     }
@@ -489,19 +502,24 @@ private:
         const Index* lstart = lstart_.data();
         const Index* lslot = lslot_.data();
         const Slot<T>* slot = slot_.data();
-        const std::uint8_t* near_wall = near_wall_.data();
         const std::size_t total = partner_.size(), blocks = (total + kBlock - 1) / kBlock;
+        per_thread_walls();
 #pragma omp parallel reduction(+ : pp, pw) if (par_)
         {
             const auto [lo, hi] = thread_range(n);
+            const std::size_t t = std::size_t(thread_index());
             refresh_kin(lo, hi);
+            pw += walls_in(lo, hi, t);
+            const WallCandidate* wc = wall_cand_[t].data();
+            const Load<T>* wr = wall_res_[t].data();
+            const std::size_t nwc = wall_cand_[t].size();
+            std::size_t e = 0;
 #pragma omp barrier
             // Every contact once, into its slot, a pack of candidates at a time.
 #pragma omp for schedule(static)
             for (std::size_t b = 0; b < blocks; ++b) pp += slots_of(b * kBlock, std::min(total, (b + 1) * kBlock), nullptr);
             // Each particle's sum in the canonical order: as j (partners of lower id, ascending), as i
             // (partners of higher id, ascending), its walls in wall order; then Newton.
-            mark_walls(lo, hi);
             for (std::size_t s = lo; s < hi; ++s) {
                 Vec3<T> F{}, Tq{};
                 for (Index e = lstart[s]; e < lstart[s + 1]; ++e) {
@@ -514,9 +532,11 @@ private:
                     F += c.f;
                     if constexpr (M::rotation) Tq += c.ti;
                 }
-                if (near_wall[s]) pw += walls_of(s, F, Tq);
-                finish(s, F, Tq);
+                add_walls(s, wc, wr, nwc, e, F, Tq);
+                put(f_, s, F);
+                put(t_, s, Tq);
             }
+            newton(lo, hi);
         }
         pp_ = pp;
         pw_ = pw;
@@ -530,7 +550,7 @@ private:
     }
 
     // near_wall[s] for s in [lo, hi): may s touch any wall (may_touch_wall, vectorised over the
-    // particles, a wall at a time)? Only those go through walls_of; in a bed most touch none. A scene
+    // particles, a wall at a time)? Only those are tested wall by wall; in a bed most touch none. A scene
     // has a handful of walls: testing each every step costs less than a wall list, and keeps the moving
     // wall out of the rebuild criterion.
     void mark_walls(std::size_t lo, std::size_t hi)
@@ -548,30 +568,108 @@ private:
         }
     }
 
-    // Walls of particle s in wall order, added to F and Tq; returns the contacts found.
-    std::int64_t walls_of(std::size_t s, Vec3<T>& F, Vec3<T>& Tq) const
+    void per_thread_walls()
     {
+        const std::size_t limit = std::size_t(thread_limit());
+        if (wall_cand_.size() < limit) {
+            wall_cand_.resize(limit);
+            wall_res_.resize(limit);
+        }
+    }
+
+    // The wall contacts of [lo, hi), thread t's particles: the pairs that may touch (by particle, then
+    // wall order), then the law kLanes pairs at a time, into wall_res_[t] (zeros where h <= 0). Returns
+    // the contacts found.
+    std::int64_t walls_in(std::size_t lo, std::size_t hi, std::size_t t)
+    {
+        mark_walls(lo, hi);
+        std::vector<WallCandidate>& cand = wall_cand_[t];
+        cand.clear();
+        const std::uint8_t* near = near_wall_.data();
+        for (std::size_t s = lo; s < hi; ++s) {
+            if (!near[s]) continue;
+            const Quad<T> xr = kin_[s].xr;
+            for (std::size_t w = 0; w < nw_; ++w)
+                if (may_touch_wall(Vec3<T>{xr[0], xr[1], xr[2]}, xr[3], wall_point(w), wall_normal(w))) cand.push_back({Index(s), Index(w)});
+        }
+        std::vector<Load<T>>& res = wall_res_[t];
+        res.resize(cand.size());
         std::int64_t found = 0;
-        for (std::size_t w = 0; w < nw_; ++w) {
-            ContactForce<T> cf;
-            if (!may_touch_wall(get(x_, s), r_[s], wall_point(w), wall_normal(w))) continue;
-            if (!wall_contact<M>(get(x_, s), get(v_, s), get(w_, s), r_[s], m_[s], wall_point(w), wall_normal(w), wall_velocity(w),
-                                 params_, cf))
-                continue;
-            F += cf.f_i;
-            if constexpr (M::rotation) Tq += cf.t_i;
-            ++found;
+        for (std::size_t e = 0; e < cand.size(); e += kLanes)
+            found += pack_of_walls(cand.data() + e, int(std::min<std::size_t>(kLanes, cand.size() - e)), res.data() + e);
+        return found;
+    }
+
+    // The wall law for up to kLanes particle–wall pairs, as pack_of_slots for pairs; each lane's bits
+    // are those wall_contact gives.
+    int pack_of_walls(const WallCandidate* cand, int count, Load<T>* out) const
+    {
+        std::size_t s[kLanes], w[kLanes];
+        for (int l = 0; l < kLanes; ++l) {
+            s[l] = std::size_t(cand[l < count ? l : count - 1].s);
+            w[l] = std::size_t(cand[l < count ? l : count - 1].w);
+        }
+        Quad<T> rows[kLanes];
+        Lanes xr[4]{}, v[4]{}, om[4]{}, p[4]{}, nrm[4]{}, vw[4]{};
+        auto lanes = [&](auto&& row, Lanes* to) {
+            for (int l = 0; l < kLanes; ++l) rows[l] = row(l);
+            rows_to_lanes<Lanes>(rows, to);
+        };
+        lanes([&](int l) { return kin_[s[l]].xr; }, xr);
+        lanes([&](int l) { return kin_[s[l]].v; }, v);
+        if constexpr (M::rotation) lanes([&](int l) { return kin_[s[l]].w; }, om);
+        lanes([&](int l) { return wall_rec_[w[l]].p; }, p);
+        lanes([&](int l) { return wall_rec_[w[l]].n; }, nrm);
+        if constexpr (M::moving_walls) lanes([&](int l) { return wall_rec_[w[l]].v; }, vw);
+        ContactForce<Lanes> c;
+        auto vec = [](const Lanes* a) { return Vec3<Lanes>{a[0], a[1], a[2]}; };
+        static_assert(M::polydisperse, "the wall kernel computes each particle's coefficients");
+        const auto touch = wall_contact_lanes<M>(vec(xr), vec(v), vec(om), xr[3], v[3], vec(p), vec(nrm), vec(vw), params_,
+                                                 Coefficients<Lanes>{}, c);
+        const Lanes zero{};
+        const Lanes gf[4] = {c.f_i.x, c.f_i.y, c.f_i.z, zero}, gt[4] = {c.t_i.x, c.t_i.y, c.t_i.z, zero};
+        Quad<T> f[kLanes], tq[kLanes];
+        lanes_to_rows<Lanes>(gf, f);
+        if constexpr (M::rotation) lanes_to_rows<Lanes>(gt, tq);
+        int found = 0;
+        for (int l = 0; l < count; ++l) {
+            out[l].f = f[l];
+            if constexpr (M::rotation) out[l].t = tq[l];
+            found += int(touch[l] != 0);
         }
         return found;
     }
 
-    // Stores the loads of s and applies Newton's law: a = F/m + g, α = T/I.
-    void finish(std::size_t s, const Vec3<T>& F, const Vec3<T>& Tq)
+    // Adds particle s's wall contacts (wall order; zeros for a pair out of contact add nothing) from the
+    // thread's wall results; e is the cursor into them, advanced past s.
+    static void add_walls(std::size_t s, const WallCandidate* wc, const Load<T>* wr, std::size_t nwc, std::size_t& e, Vec3<T>& F, Vec3<T>& Tq)
     {
-        put(f_, s, F);
-        put(t_, s, Tq);
-        put(acc_, s, {acceleration(F.x, m_[s], g_.x), acceleration(F.y, m_[s], g_.y), acceleration(F.z, m_[s], g_.z)});
-        if constexpr (M::rotation) put(alc_, s, {Tq.x / I_[s], Tq.y / I_[s], Tq.z / I_[s]});
+        for (; e < nwc && std::size_t(wc[e].s) == s; ++e) {
+            F += Vec3<T>{wr[e].f[0], wr[e].f[1], wr[e].f[2]};
+            if constexpr (M::rotation) Tq += Vec3<T>{wr[e].t[0], wr[e].t[1], wr[e].t[2]};
+        }
+    }
+
+    // Newton's law for [lo, hi) from the loads in f_ and t_: a = F/m + g, α = T/I. A pass of its own,
+    // so that the divisions go a pack at a time.
+    void newton(std::size_t lo, std::size_t hi)
+    {
+        const std::size_t n = n_;
+        const T* __restrict m = m_.data();
+        const T* __restrict inertia = I_.data();
+        for (int c = 0; c < 3; ++c) {
+            const T* __restrict f = f_.data() + std::size_t(c) * n;
+            T* __restrict acc = acc_.data() + std::size_t(c) * n;
+            const T g = component(g_, c);
+#pragma omp simd
+            for (std::size_t s = lo; s < hi; ++s) acc[s] = acceleration(f[s], m[s], g);
+            if constexpr (M::rotation) {
+                const T* __restrict t = t_.data() + std::size_t(c) * n;
+                T* __restrict alc = alc_.data() + std::size_t(c) * n;
+#pragma omp simd
+                for (std::size_t s = lo; s < hi; ++s) alc[s] = t[s] / inertia[s];
+            }
+        }
     }
 
     // Unordered: each pair's force added to both particles as the pack computes it, into loads of the
@@ -582,6 +680,7 @@ private:
         const std::size_t n = n_;
         const std::size_t limit = std::size_t(thread_limit());
         if (loads_.size() < limit) loads_.resize(limit);
+        per_thread_walls();
         std::int64_t pp = 0, pw = 0;
 #pragma omp parallel reduction(+ : pp, pw) if (par_)
         {
@@ -594,7 +693,11 @@ private:
             const auto [z0, z1] = spans_known ? spans_[t] : std::pair<std::size_t, std::size_t>{0, n};
             std::fill(mine.begin() + std::ptrdiff_t(z0), mine.begin() + std::ptrdiff_t(z1), Load<T>{});
             refresh_kin(lo, hi);
-            mark_walls(lo, hi);
+            pw += walls_in(lo, hi, t);
+            const WallCandidate* wc = wall_cand_[t].data();
+            const Load<T>* wr = wall_res_[t].data();
+            const std::size_t nwc = wall_cand_[t].size();
+            std::size_t e = 0;
 #pragma omp barrier
             pp += slots_of(std::size_t(pstart_[lo]), std::size_t(pstart_[hi]), mine.data());
 #pragma omp barrier
@@ -607,9 +710,11 @@ private:
                     tq += loads_[u][s].t;
                 }
                 Vec3<T> F{f[0], f[1], f[2]}, Tq{tq[0], tq[1], tq[2]};
-                if (near_wall_[s]) pw += walls_of(s, F, Tq);
-                finish(s, F, Tq);
+                add_walls(s, wc, wr, nwc, e, F, Tq);
+                put(f_, s, F);
+                put(t_, s, Tq);
             }
+            newton(lo, hi);
         }
         pp_ = pp;
         pw_ = pw;
@@ -833,7 +938,7 @@ private:
     std::vector<T> f_, t_, acc_, alc_, xref_, tmp_;                          // (3N)
     std::vector<T> r_, m_, I_, tmp1_;                                        // (N)
     std::vector<Index> id_, pos_, tmpi_;                                     // (N)
-    std::vector<T> wp_, wn_, wv_;                                            // (walls, 3)
+    std::vector<WallRecord<T>> wall_rec_;                                    // (walls)
     // The neighbour list: pairs of s in [pstart[s], pstart[s+1]), one slot each; where s is the partner.
     std::vector<Index> pstart_, partner_, owner_, lstart_, lslot_;
     std::vector<Slot<T>> slot_;
@@ -841,6 +946,8 @@ private:
     std::vector<std::uint8_t> touch_;         // each listed pair: in contact this step (then slot_ holds it; canonical)
     std::vector<Kin<T>> kin_;                 // (N) the kernel's copy of x, R, v, ω
     std::vector<std::uint8_t> near_wall_;   // (N) may touch a wall this step
+    std::vector<std::vector<WallCandidate>> wall_cand_;  // per thread: the particle–wall pairs that may touch
+    std::vector<std::vector<Load<T>>> wall_res_;         // per thread: their force and torque (zeros: no contact)
     std::vector<Key> key_, keytmp_;
     std::vector<std::int64_t> cell3_;  // (3N) cell coordinates at the last rebuild
     std::vector<Index> cstart_;        // first storage slot of each cell (dense grid), cells + 1

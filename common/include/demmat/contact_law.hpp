@@ -193,6 +193,25 @@ inline auto particle_contact_lanes(const Vec3<V>& xi, const Vec3<V>& xj, const V
     return touch;
 }
 
+namespace detail {
+// The particle–wall law once the overlap h > 0 is known (in every lane whose result is kept).
+template <class M, class T, class S>
+inline void wall_law(T h, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T mi, const Vec3<T>& normal, const Vec3<T>& vw,
+                     const ContactParams<S>& p, const Coefficients<T>& mono, ContactForce<T>& out)
+{
+    const Vec3<T> n = -normal;
+    const Vec3<T> di = (ri - h * S(0.5)) * n;
+    Vec3<T> u = vi;
+    if constexpr (M::moving_walls) u = vi - vw;
+    if constexpr (M::rotation) u = u + cross(wi, di);
+    Vec3<T> ft;
+    if constexpr (M::polydisperse) contact_force<M>(n, h, u, wall_coefficients(ri, mi, p), p, out.f_i, ft);
+    else contact_force<M>(n, h, u, mono, p, out.f_i, ft);
+    if constexpr (M::rotation) out.t_i = cross(di, ft);
+    out.overlap = h;
+}
+} // namespace detail
+
 // Particle–wall contact: the wall is a plane through `point` with unit normal `normal` pointing into
 // the domain, moving with velocity `vw` (read only by a model with moving walls; a fixed wall's is
 // zero, and v_i − 0 = v_i exactly); R* = R_i, m* = m_i, E* from the particle and wall materials. `mono`
@@ -205,17 +224,26 @@ inline bool wall_contact(const Vec3<T>& xi, const Vec3<T>& vi, const Vec3<T>& wi
     const T s = dot(xi - point, normal);
     const T h = ri - s;
     if (!(h > T(0))) return false;
-    const Vec3<T> n = -normal;
-    const Vec3<T> di = (ri - h * T(0.5)) * n;
-    Vec3<T> u = vi;
-    if constexpr (M::moving_walls) u = vi - vw;
-    if constexpr (M::rotation) u = u + cross(wi, di);
-    Vec3<T> ft;
-    if constexpr (M::polydisperse) detail::contact_force<M>(n, h, u, wall_coefficients(ri, mi, p), p, out.f_i, ft);
-    else detail::contact_force<M>(n, h, u, mono, p, out.f_i, ft);
-    if constexpr (M::rotation) out.t_i = cross(di, ft);
-    out.overlap = h;
+    detail::wall_law<M>(h, vi, wi, ri, mi, normal, vw, p, mono, out);
     return true;
+}
+
+// W particle–wall pairs at once, one per lane (each lane its own particle and wall): the same law,
+// operation for operation, as particle_contact_lanes is for pairs. Returns the lanes in contact; the
+// others hold zeros in f_i and t_i.
+template <class M, LanePack V>
+inline auto wall_contact_lanes(const Vec3<V>& xi, const Vec3<V>& vi, const Vec3<V>& wi, V ri, V mi, const Vec3<V>& point,
+                               const Vec3<V>& normal, const Vec3<V>& vw, const ContactParams<LaneScalar<V>>& p,
+                               const Coefficients<V>& mono, ContactForce<V>& out)
+{
+    const V s = dot(xi - point, normal);
+    const V h = ri - s;
+    const auto touch = h > V{};
+    detail::wall_law<M>(h, vi, wi, ri, mi, normal, vw, p, mono, out);
+    auto keep = [&](Vec3<V>& a) { a = {touch ? a.x : V{}, touch ? a.y : V{}, touch ? a.z : V{}}; };
+    keep(out.f_i);
+    if constexpr (M::rotation) keep(out.t_i);
+    return touch;
 }
 
 template <class M, class T>
