@@ -101,7 +101,7 @@ struct alignas(2 * sizeof(Quad<T>)) Load {
 
 // In-place transpose of a 4×4 block: afterwards a[c] holds what was lane c of the four, and so on.
 template <class T>
-inline void transpose4(Quad<T>& a, Quad<T>& b, Quad<T>& c, Quad<T>& d)
+[[gnu::always_inline]] inline void transpose4(Quad<T>& a, Quad<T>& b, Quad<T>& c, Quad<T>& d)
 {
     const Quad<T> t0 = __builtin_shufflevector(a, b, 0, 4, 2, 6), t1 = __builtin_shufflevector(a, b, 1, 5, 3, 7);
     const Quad<T> t2 = __builtin_shufflevector(c, d, 0, 4, 2, 6), t3 = __builtin_shufflevector(c, d, 1, 5, 3, 7);
@@ -112,9 +112,11 @@ inline void transpose4(Quad<T>& a, Quad<T>& b, Quad<T>& c, Quad<T>& d)
 }
 
 // rows[l] is lane l's quad; out[c][l] = rows[l][c]. A transpose of whole vectors (a few shuffles per
-// pack) instead of one scalar load and one lane insert per value. Moves bits, computes nothing.
+// pack) instead of one scalar load and one lane insert per value. Moves bits, computes nothing. (Always
+// inlined: called out of line, as GCC chose once the kernel had a few callers, the vectors go through
+// memory and the step took 20 % longer.)
 template <class V>
-inline void rows_to_lanes(const Quad<LaneScalar<V>>* rows, V out[4])
+[[gnu::always_inline]] inline void rows_to_lanes(const Quad<LaneScalar<V>>* rows, V out[4])
 {
     using T = LaneScalar<V>;
     constexpr int W = lane_count<V>;
@@ -141,7 +143,7 @@ inline void rows_to_lanes(const Quad<LaneScalar<V>>* rows, V out[4])
 
 // The inverse: rows[l] = {in[0][l], in[1][l], in[2][l], in[3][l]}.
 template <class V>
-inline void lanes_to_rows(const V in[4], Quad<LaneScalar<V>>* rows)
+[[gnu::always_inline]] inline void lanes_to_rows(const V in[4], Quad<LaneScalar<V>>* rows)
 {
     using T = LaneScalar<V>;
     constexpr int W = lane_count<V>;
@@ -373,6 +375,7 @@ private:
     // every pair it rejects), so the skin's extra candidates cost a distance, not a pass through the law;
     // the rest go through the law kLanes at a time. The test sorts the slots into kept and dropped
     // without a branch (a third are dropped, in no pattern a predictor learns). Returns the contacts found.
+    template <bool Canonical>
     std::int64_t slots_of(std::size_t k0, std::size_t k1, Load<T>* load)
     {
         const Index* owner = owner_.data();
@@ -383,7 +386,25 @@ private:
         for (std::size_t c0 = k0; c0 < k1; c0 += kBlock) {
             const std::size_t c1 = std::min(k1, c0 + kBlock);
             std::size_t nk = 0, nd = 0;
-            for (std::size_t k = c0; k < c1; ++k) {
+            std::size_t k = c0;
+            // kLanes candidates at a time: both records transposed into lanes, the test on the lanes
+            // (the remainder one by one).
+            for (; k + kLanes <= c1; k += kLanes) {
+                Quad<T> rows[kLanes];
+                Lanes a[4], b[4];
+                for (int l = 0; l < kLanes; ++l) rows[l] = kin[owner[k + std::size_t(l)]].xr;
+                rows_to_lanes<Lanes>(rows, a);
+                for (int l = 0; l < kLanes; ++l) rows[l] = kin[partner[k + std::size_t(l)]].xr;
+                rows_to_lanes<Lanes>(rows, b);
+                const auto t = may_touch_lanes(Vec3<Lanes>{a[0], a[1], a[2]}, Vec3<Lanes>{b[0], b[1], b[2]}, a[3], b[3]);
+                for (int l = 0; l < kLanes; ++l) {
+                    kept[nk] = k + std::size_t(l);
+                    dropped[nd] = k + std::size_t(l);
+                    nk += std::size_t(t[l] != 0);
+                    nd += std::size_t(t[l] == 0);
+                }
+            }
+            for (; k < c1; ++k) {
                 const Quad<T> a = kin[owner[k]].xr, b = kin[partner[k]].xr;
                 const bool t = may_touch(Vec3<T>{a[0], a[1], a[2]}, Vec3<T>{b[0], b[1], b[2]}, a[3], b[3]);
                 kept[nk] = k;
@@ -392,14 +413,14 @@ private:
                 nd += std::size_t(!t);
             }
             // A dropped slot is zeroed when it was not dropped the step before (most stay dropped).
-            if (opt_.canonical)
+            if constexpr (Canonical)
                 for (std::size_t e = 0; e < nd; ++e) {
                     const std::size_t k = dropped[e];
                     if (!touch_[k]) continue;
                     touch_[k] = 0;
                     slot_[k] = Slot<T>{};
                 }
-            for (std::size_t e = 0; e < nk; e += kLanes) found += pack_of_slots(kept + e, int(std::min<std::size_t>(kLanes, nk - e)), load);
+            for (std::size_t e = 0; e < nk; e += kLanes) found += pack_of_slots<Canonical>(kept + e, int(std::min<std::size_t>(kLanes, nk - e)), load);
         }
         return found;
     }
@@ -408,6 +429,7 @@ private:
     // both particles' records and the pair's coefficients (computed when it was listed) transposed into
     // the lanes, particle_contact_lanes, and the lanes transposed back into the slots (zeros where
     // h <= 0) or added to the loads. Each lane's bits are those particle_contact gives for its slot's pair.
+    template <bool Canonical>
     int pack_of_slots(const std::size_t* ks, int count, Load<T>* load)
     {
         std::size_t k[kLanes], s[kLanes], q[kLanes];
@@ -440,7 +462,7 @@ private:
             Lanes{}, params_, Coefficients<Lanes>{kc[0], kc[1], kc[2]}, c);
         int found = 0;
         for (int l = 0; l < count; ++l) found += int(touch[l] != 0);
-        if (opt_.canonical) {
+        if constexpr (Canonical) {
             // A slot is nine values: f, t_i, t_j; the first eight go as two quads, the ninth alone.
             static_assert(sizeof(Slot<T>) == 9 * sizeof(T));
             const Lanes g0[4] = {c.f_i.x, c.f_i.y, c.f_i.z, c.t_i.x}, g1[4] = {c.t_i.y, c.t_i.z, c.t_j.x, c.t_j.y};
@@ -517,7 +539,7 @@ private:
 #pragma omp barrier
             // Every contact once, into its slot, a pack of candidates at a time.
 #pragma omp for schedule(static)
-            for (std::size_t b = 0; b < blocks; ++b) pp += slots_of(b * kBlock, std::min(total, (b + 1) * kBlock), nullptr);
+            for (std::size_t b = 0; b < blocks; ++b) pp += slots_of<true>(b * kBlock, std::min(total, (b + 1) * kBlock), nullptr);
             // Each particle's sum in the canonical order: as j (partners of lower id, ascending), as i
             // (partners of higher id, ascending), its walls in wall order; then Newton.
             for (std::size_t s = lo; s < hi; ++s) {
@@ -699,7 +721,7 @@ private:
             const std::size_t nwc = wall_cand_[t].size();
             std::size_t e = 0;
 #pragma omp barrier
-            pp += slots_of(std::size_t(pstart_[lo]), std::size_t(pstart_[hi]), mine.data());
+            pp += slots_of<false>(std::size_t(pstart_[lo]), std::size_t(pstart_[hi]), mine.data());
 #pragma omp barrier
             for (std::size_t s = lo; s < hi; ++s) {
                 Quad<T> f{}, tq{};

@@ -50,6 +50,16 @@ inline bool may_touch(const Vec3<T>& xi, const Vec3<T>& xj, T ri, T rj)
     return d2 < s * s * T(1.000000001);
 }
 
+// The same test on W pairs at once (lanes.hpp), the same operations lane by lane: nonzero in the lanes
+// may_touch accepts.
+template <LanePack V>
+inline auto may_touch_lanes(const Vec3<V>& xi, const Vec3<V>& xj, V ri, V rj)
+{
+    const Vec3<V> dx = xj - xi;
+    const V d2 = dot(dx, dx);
+    const V s = ri + rj;
+    return d2 < s * s * LaneScalar<V>(1.000000001);
+}
 template <class T>
 inline bool may_touch_wall(const Vec3<T>& xi, T ri, const Vec3<T>& point, const Vec3<T>& normal)
 {
