@@ -542,18 +542,27 @@ private:
             for (std::size_t b = 0; b < blocks; ++b) pp += slots_of<true>(b * kBlock, std::min(total, (b + 1) * kBlock), nullptr);
             // Each particle's sum in the canonical order: as j (partners of lower id, ascending), as i
             // (partners of higher id, ascending), its walls in wall order; then Newton.
+            // The three components of a sum go as lanes of one quad (lane by lane, the scalar additions;
+            // x - y is x + (-y)), each read as the quad that starts at it in the slot: f, t_i and t_j
+            // are three consecutive values, and the fourth lane, the next value along, is not used.
+            const T* base = reinterpret_cast<const T*>(slot);
+            auto quad_at = [base](std::size_t k, std::size_t offset) {
+                Quad<T> q;
+                std::memcpy(&q, base + 9 * k + offset, sizeof(q));
+                return q;
+            };
             for (std::size_t s = lo; s < hi; ++s) {
-                Vec3<T> F{}, Tq{};
+                Quad<T> f{}, tq{};
                 for (Index e = lstart[s]; e < lstart[s + 1]; ++e) {
-                    const Slot<T>& c = slot[lslot[e]];
-                    F += -c.f;
-                    if constexpr (M::rotation) Tq += c.tj;
+                    const std::size_t k = std::size_t(lslot[e]);
+                    f -= quad_at(k, 0);
+                    if constexpr (M::rotation) tq += quad_at(k, 6);
                 }
                 for (Index k = pstart[s]; k < pstart[s + 1]; ++k) {
-                    const Slot<T>& c = slot[k];
-                    F += c.f;
-                    if constexpr (M::rotation) Tq += c.ti;
+                    f += quad_at(std::size_t(k), 0);
+                    if constexpr (M::rotation) tq += quad_at(std::size_t(k), 3);
                 }
+                Vec3<T> F{f[0], f[1], f[2]}, Tq{tq[0], tq[1], tq[2]};
                 add_walls(s, wc, wr, nwc, e, F, Tq);
                 put(f_, s, F);
                 put(t_, s, Tq);
@@ -898,7 +907,7 @@ private:
                 partner_.resize(total);
                 owner_.resize(total);
                 if (canonical) {
-                    slot_.resize(total);
+                    slot_.resize(total + 1);  // + 1: the sums read a quad from the last slot's t_j
                     touch_.assign(total, 1);  // "maybe in contact": the first pass zeroes the slots it drops
                 }
                 pcoef_.resize(total);
