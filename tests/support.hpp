@@ -3,6 +3,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <memory>
+#include <utility>
 #include <string>
 #include <vector>
 
@@ -40,8 +41,8 @@ inline std::int64_t long_run(std::int64_t steps) { return steps / kLongRunDiviso
 struct VariantRun {
     std::unique_ptr<Variant> variant;
     std::unique_ptr<Driver> driver;
-    VariantRun(const std::string& name, const Setup& setup)
-        : variant(registry().find(name).create()), driver(std::make_unique<Driver>(*variant, setup)) {}
+    VariantRun(const std::string& name, const Setup& setup) : VariantRun(registry().find(name).create(), setup) {}
+    VariantRun(std::unique_ptr<Variant> v, const Setup& setup) : variant(std::move(v)), driver(std::make_unique<Driver>(*variant, setup)) {}
     Snapshot snapshot() const
     {
         Snapshot s;

@@ -185,8 +185,9 @@ public:
         g_ = cast<T>(scene.gravity);
         walls_ = s.walls;
         nw_ = walls_.size();
-        // Below ~1000 particles a fork and join per phase costs more than the work it shares.
-        par_ = n_ >= 1000;
+        // (min_parallel's default: on the settled beds, 2 threads against 1 took 0.083 against 0.080 µs
+        // per particle-step at N = 2000, 0.055 against 0.080 at 4000.)
+        par_ = n_ >= opt_.min_parallel;
         skin_ = T(opt_.skin * setup.radius_max);
         // Cells at least as wide as the longest listed pair; a wider scene cell is honoured (it only
         // changes the candidates, never the contact set).

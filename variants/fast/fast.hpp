@@ -1,6 +1,7 @@
 #pragma once
 // The fast variant's options and its few extra observables, for the tests (the registry creates it with
 // the defaults; the Variant interface knows no options).
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 
@@ -17,6 +18,10 @@ struct FastOptions {
     // arrays for any thread count). false: plain accumulation in storage order, each pair's force added
     // to both particles as it is computed (the trajectory differs from arrays in the last bits).
     bool canonical = true;
+    // Below this many particles the variant runs on one thread whatever the thread count: a fork and
+    // join per phase costs more than the work it shares (docs/variants.md, "fast"). The tests set 0, so
+    // that their small scenes run on the threads they ask for.
+    std::size_t min_parallel = 3000;
 };
 
 class FastVariant : public Variant {
