@@ -186,9 +186,8 @@ template <class T>
 bool same_bits(T a, T b) { return std::memcmp(&a, &b, sizeof(T)) == 0; }
 
 // Runs the packed law on samples W at a time and checks every lane against the scalar law, bit for bit;
-// lanes out of contact must hold +0. Given: the lanes get each pair's coefficients precomputed (as the
-// fast variant stores them per listed pair) and zero masses, which the law must then not read.
-template <class M, class T, int W, bool Given = false>
+// lanes out of contact must hold +0.
+template <class M, class T, int W>
 void check_lanes_against_scalar()
 {
     using V = Pack<T, W>;
@@ -200,11 +199,8 @@ void check_lanes_against_scalar()
     for (std::size_t b = 0; b < samples.size(); b += W) {
         Vec3<V> xi, xj, vi, vj, wi, wj;
         V ri{}, rj{}, mi{}, mj{};
-        Coefficients<V> given;
         for (int l = 0; l < W; ++l) {
             const PairSample<T>& s = samples[b + std::size_t(l)];
-            const Coefficients<T> k = pair_coefficients(s.ri, s.rj, s.mi, s.mj, p);
-            given.kn[l] = k.kn; given.cn[l] = k.cn; given.ct[l] = k.ct;
             for (int c = 0; c < 3; ++c) {
                 component(xi, c)[l] = component(s.xi, c);
                 component(xj, c)[l] = component(s.xj, c);
@@ -216,8 +212,7 @@ void check_lanes_against_scalar()
             ri[l] = s.ri; rj[l] = s.rj; mi[l] = s.mi; mj[l] = s.mj;
         }
         ContactForce<V> lanes;
-        const auto touch = Given ? particle_contact_lanes<CoefficientsGiven<M>>(xi, xj, vi, vj, wi, wj, ri, rj, V{}, V{}, p, given, lanes)
-                                 : particle_contact_lanes<M>(xi, xj, vi, vj, wi, wj, ri, rj, mi, mj, p, mono_lanes, lanes);
+        const auto touch = particle_contact_lanes<M>(xi, xj, vi, vj, wi, wj, ri, rj, mi, mj, p, mono_lanes, lanes);
         for (int l = 0; l < W; ++l) {
             const PairSample<T>& s = samples[b + std::size_t(l)];
             ContactForce<T> one;
@@ -253,9 +248,6 @@ TEST(ContactLaw, EveryLaneOfAPackHasTheScalarLawsBits)
     check_lanes_against_scalar<Model<false, false, true>, double, native_lanes<double>>();                  // with damping
     // A pack wider than the machine's vectors (lowered to several) and the generic sqrt fallback.
     check_lanes_against_scalar<FullModel, double, 2 * native_lanes<double>>();
-    // Coefficients computed once per pair beforehand (the fast variant) give the same bits.
-    check_lanes_against_scalar<FullModel, double, native_lanes<double>, true>();
-    check_lanes_against_scalar<FullModel, float, native_lanes<float>, true>();
 }
 
 namespace {

@@ -155,9 +155,8 @@ inline void pair_law(const Vec3<T>& dx, T d, T h, const Vec3<T>& vi, const Vec3<
 } // namespace detail
 
 // Particle–particle contact, i < j by id. Returns false (and writes nothing) when h <= 0. `mono` holds
-// pair_coefficients of the scene's one radius and mass (or the pair's own, computed beforehand: see
-// CoefficientsGiven, model.hpp); only a model with !M::polydisperse reads it, a polydisperse one computes
-// the pair's own from r_i, r_j, m_i, m_j.
+// pair_coefficients of the scene's one radius and mass; only a model with !M::polydisperse reads it, a
+// polydisperse one computes the pair's own from r_i, r_j, m_i, m_j.
 template <class M, class T>
 inline bool particle_contact(const Vec3<T>& xi, const Vec3<T>& xj, const Vec3<T>& vi, const Vec3<T>& vj,
                              const Vec3<T>& wi, const Vec3<T>& wj, T ri, T rj, T mi, T mj,

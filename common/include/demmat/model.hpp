@@ -24,13 +24,6 @@ struct Model {
 // The paper's full model: what every variant runs unless a scene asks for less.
 using FullModel = Model<true, true, true, true, true, true>;
 
-// M, except that the law takes each pair's coefficients from its caller (the `mono` argument of
-// particle_contact*) instead of deriving them from R_i, R_j, m_i, m_j: for a code that computes
-// pair_coefficients once per listed pair (they are constant while the pair is listed). The same
-// operations run, earlier, so the bits are M's.
-template <class M>
-using CoefficientsGiven = Model<M::rotation, M::friction, M::damping, M::walls, M::moving_walls, false>;
-
 // The same flags at run time: what a scene needs (features_of) or what an instantiation models.
 struct ModelFeatures {
     bool rotation = false, friction = false, damping = false, walls = false, moving_walls = false, polydisperse = false;
