@@ -525,12 +525,7 @@ private:
         {
             const auto [lo, hi] = thread_range(n);
             const std::size_t t = std::size_t(thread_index());
-            refresh_kin(lo, hi);
-            pw += walls_in(lo, hi, t);
-            const WallCandidate* wc = wall_cand_[t].data();
-            const Load<T>* wr = wall_res_[t].data();
-            const std::size_t nwc = wall_cand_[t].size();
-            std::size_t e = 0;
+            WallCursor walls = begin_forces(lo, hi, t, pw);
 #pragma omp barrier
             // Every contact once, into its slot, a pack of candidates at a time.
 #pragma omp for schedule(static)
@@ -558,7 +553,7 @@ private:
                     if constexpr (M::rotation) tq += quad_at(std::size_t(k), 3);
                 }
                 Vec3<T> F{f[0], f[1], f[2]}, Tq{tq[0], tq[1], tq[2]};
-                add_walls(s, wc, wr, nwc, e, F, Tq);
+                walls.add(s, F, Tq);
                 put(f_, s, F);
                 put(t_, s, Tq);
             }
@@ -666,14 +661,29 @@ private:
         return found;
     }
 
-    // Adds particle s's wall contacts (wall order; zeros for a pair out of contact add nothing) from the
-    // thread's wall results; e is the cursor into them, advanced past s.
-    static void add_walls(std::size_t s, const WallCandidate* wc, const Load<T>* wr, std::size_t nwc, std::size_t& e, Vec3<T>& F, Vec3<T>& Tq)
-    {
-        for (; e < nwc && std::size_t(wc[e].s) == s; ++e) {
-            F += Vec3<T>{wr[e].f[0], wr[e].f[1], wr[e].f[2]};
-            if constexpr (M::rotation) Tq += Vec3<T>{wr[e].t[0], wr[e].t[1], wr[e].t[2]};
+    // A thread's wall results, read by its sums in particle order.
+    struct WallCursor {
+        const WallCandidate* cand;
+        const Load<T>* res;
+        std::size_t count, next = 0;
+        // Adds particle s's wall contacts (wall order; zeros for a pair out of contact add nothing) and
+        // moves past them.
+        void add(std::size_t s, Vec3<T>& F, Vec3<T>& Tq)
+        {
+            for (; next < count && std::size_t(cand[next].s) == s; ++next) {
+                F += Vec3<T>{res[next].f[0], res[next].f[1], res[next].f[2]};
+                if constexpr (M::rotation) Tq += Vec3<T>{res[next].t[0], res[next].t[1], res[next].t[2]};
+            }
         }
+    };
+
+    // The start of a force pass for thread t's particles [lo, hi): their kernel records, and their wall
+    // contacts (counted into pw), for the sums to add.
+    WallCursor begin_forces(std::size_t lo, std::size_t hi, std::size_t t, std::int64_t& pw)
+    {
+        refresh_kin(lo, hi);
+        pw += walls_in(lo, hi, t);
+        return {wall_cand_[t].data(), wall_res_[t].data(), wall_cand_[t].size()};
     }
 
     // Newton's law for [lo, hi) from the loads in f_ and t_: a = F/m + g, α = T/I. A pass of its own,
@@ -718,12 +728,7 @@ private:
             if (mine.size() != n) mine.resize(n);
             const auto [z0, z1] = spans_known ? spans_[t] : std::pair<std::size_t, std::size_t>{0, n};
             std::fill(mine.begin() + std::ptrdiff_t(z0), mine.begin() + std::ptrdiff_t(z1), Load<T>{});
-            refresh_kin(lo, hi);
-            pw += walls_in(lo, hi, t);
-            const WallCandidate* wc = wall_cand_[t].data();
-            const Load<T>* wr = wall_res_[t].data();
-            const std::size_t nwc = wall_cand_[t].size();
-            std::size_t e = 0;
+            WallCursor walls = begin_forces(lo, hi, t, pw);
 #pragma omp barrier
             pp += slots_of<false>(std::size_t(pstart_[lo]), std::size_t(pstart_[hi]), mine.data());
 #pragma omp barrier
@@ -736,7 +741,7 @@ private:
                     tq += loads_[u][s].t;
                 }
                 Vec3<T> F{f[0], f[1], f[2]}, Tq{tq[0], tq[1], tq[2]};
-                add_walls(s, wc, wr, nwc, e, F, Tq);
+                walls.add(s, F, Tq);
                 put(f_, s, F);
                 put(t_, s, Tq);
             }
