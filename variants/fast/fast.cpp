@@ -236,7 +236,7 @@ public:
     {
         // Rebuild when a pair may have closed by more than the skin since the last rebuild:
         // |Δx_i| + |Δx_j| ≤ 2·max|Δx|. 0.9 leaves room for rounding; a NaN fails the test and goes to
-        // the rebuild, whose cell search reports it. (Walls need no list: see walls_of.)
+        // the rebuild, whose cell search reports it. (Walls need no list: see mark_walls.)
         const T half = T(0.9) * skin_ * T(0.5);
         bool need = !(half > T(0));
         if (!need) {
