@@ -24,9 +24,24 @@ PHASES = ["predict", "search", "forces", "correct"]
 GROUPS = PHASES + ["search_plus_forces", "total"]
 
 
+def series(variant, threads, multi):
+    """A bar's name: the variant, and its thread count where the run timed several (`--threads 1,2`)."""
+    return f"{variant} ×{threads}" if multi.get(variant, False) else variant
+
+
+def several_counts(entries):
+    """variant -> whether the run timed it at more than one thread count."""
+    seen = {}
+    for e in entries:
+        seen.setdefault(e["variant"], set()).add(e.get("threads", 0))
+    return {v: len(t) > 1 for v, t in seen.items()}
+
+
 def tidy_samples(bench):
-    """One row per (variant, repetition, phase) with seconds per step."""
+    """One row per (series, repetition, phase) with seconds per step (a series: a variant at a thread count)."""
+    multi = several_counts(bench["summary"])
     df = pd.DataFrame(bench["samples"])
+    df["variant"] = [series(v, t, multi) for v, t in zip(df["variant"], df.get("threads", [0] * len(df)))]
     wide = df.pivot_table(index=["variant", "repetition"], columns="phase", values="seconds_per_step").reset_index()
     wide["search_plus_forces"] = wide["search"] + wide["forces"]
     wide["total"] = wide[PHASES].sum(axis=1)
@@ -124,7 +139,8 @@ def main(argv):
     a = ap.parse_args(argv)
     with open(a.bench) as f:
         bench = json.load(f)
-    order = [s["variant"] for s in bench["summary"]]
+    multi = several_counts(bench["summary"])
+    order = [series(s["variant"], s.get("threads", 0), multi) for s in bench["summary"]]
     stats = table(tidy_samples(bench), order)
     atomic_write(a.table, lambda tmp: stats.to_csv(tmp, index=False, float_format="%.6g"))
     figure(stats, order, bench, a.figure)

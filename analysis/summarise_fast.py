@@ -17,18 +17,22 @@ from atomic_io import write_text
 
 
 def load(folder):
-    rows, prov = [], None
-    for path in sorted(folder.glob("bench_settled_*_t*.json")):
-        m = re.fullmatch(r"bench_settled_(\d+)_t(\d+)\.json", path.name)
+    """One row per (N, variant, threads) from bench_settled_<N>.json (every thread count in one run,
+    interleaved); also the paired speed-ups: per repetition, the 1-thread total over the t-thread total
+    of the same variant, taken side by side."""
+    rows, paired, prov = [], [], None
+    for path in sorted(folder.glob("bench_settled_*.json")):
+        m = re.fullmatch(r"bench_settled_(\d+)\.json", path.name)
         if not m:
             continue
         d = json.loads(path.read_text())
         prov = prov or d["provenance"]
+        n = int(m.group(1))
         for s in d["summary"]:
             sec = s["seconds_per_step"]
             total = sec["total"]["median"]
             rows.append({
-                "N": int(m.group(1)), "threads": int(d["threads"]), "variant": s["variant"],
+                "N": n, "threads": int(s["threads"]), "variant": s["variant"],
                 "us_per_particle_step": s["us_per_particle_step"],
                 "min_us": sec["total"]["min"] / d["scene"]["particles"] * 1e6,
                 "max_us": sec["total"]["max"] / d["scene"]["particles"] * 1e6,
@@ -36,7 +40,15 @@ def load(folder):
                 "contacts/particle": s["contacts_per_particle"], "bytes/particle": s["memory_bytes"] / d["scene"]["particles"],
                 "repetitions": d["repetitions"], "steps": d["steps"],
             })
-    return pd.DataFrame(rows), prov
+        smp = pd.DataFrame(d["samples"])
+        tot = smp.groupby(["variant", "threads", "repetition"])["seconds_per_step"].sum().unstack("threads")
+        if 1 in tot.columns:
+            for t in tot.columns:
+                if t != 1:
+                    ratio = (tot[1] / tot[t]).dropna()
+                    for v, r in ratio.groupby(level="variant"):
+                        paired.append({"N": n, "variant": v, "threads": int(t), "paired": r.median(), "paired_min": r.min(), "paired_max": r.max()})
+    return pd.DataFrame(rows), pd.DataFrame(paired), prov
 
 
 def main(argv):
@@ -44,9 +56,9 @@ def main(argv):
     ap.add_argument("folder", type=pathlib.Path)
     ap.add_argument("-o", "--output", type=pathlib.Path)
     a = ap.parse_args(argv)
-    df, prov = load(a.folder)
+    df, paired, prov = load(a.folder)
     if df.empty:
-        print(f"summarise_fast.py: no bench_settled_<N>_t<threads>.json in {a.folder}", file=sys.stderr)
+        print(f"summarise_fast.py: no bench_settled_<N>.json in {a.folder}", file=sys.stderr)
         return 1
     df = df.sort_values(["N", "variant", "threads"])
     one = df[df.threads == 1].set_index(["N", "variant"])["us_per_particle_step"]
@@ -60,14 +72,21 @@ def main(argv):
         f"Produced by scripts/bench_fast.sh and analysis/summarise_fast.py: commit {prov['commit'][:10]}"
         f"{' (dirty)' if prov.get('dirty') else ''}, {prov['compiler']}, `{prov['flags']}`, CPU {prov['cpu']}, {prov['date']}.",
         "Median µs per particle-step over interleaved repetitions (min–max); phases as % of the step; the"
-        " dense bed settled 0.4 s by fast, then continued with the walls at rest.",
+        " dense bed settled 0.4 s by fast, then continued with the walls at rest. Every thread count of an N"
+        " ran in one `demmat bench`, interleaved with the variants; the speed-up is the ratio of the medians,"
+        " the paired speed-up the median (min–max) over the repetitions of each repetition's own ratio, its"
+        " two samples taken side by side. `arrays` is not threaded and runs once, at 1 thread.",
         "",
-        "| N | variant | threads | µs/particle-step | min–max | speed-up vs 1 thread | vs arrays (1 thread) | predict | search | forces | correct | contacts/particle | bytes/particle |",
-        "|---:|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|",
+        "| N | variant | threads | µs/particle-step | min–max | speed-up vs 1 thread | paired speed-up | vs arrays (1 thread) | predict | search | forces | correct | contacts/particle | bytes/particle |",
+        "|---:|---|---:|---:|---|---:|---|---:|---:|---:|---:|---:|---:|---:|",
     ]
+    pair = paired.set_index(["N", "variant", "threads"]) if not paired.empty else None
     for _, r in df.iterrows():
+        key = (r["N"], r["variant"], r["threads"])
+        p = f"{pair.loc[key, 'paired']:.2f} ({pair.loc[key, 'paired_min']:.2f}–{pair.loc[key, 'paired_max']:.2f})" \
+            if pair is not None and key in pair.index else ""
         out.append(f"| {r['N']} | {r['variant']} | {r['threads']} | {r['us_per_particle_step']:.3f} | {r['min_us']:.3f}–{r['max_us']:.3f} | "
-                   f"{r['speed-up vs 1 thread']:.2f} | {r['vs arrays (1 thread)']:.2f} | {r['predict %']:.0f} % | {r['search %']:.0f} % | "
+                   f"{r['speed-up vs 1 thread']:.2f} | {p} | {r['vs arrays (1 thread)']:.2f} | {r['predict %']:.0f} % | {r['search %']:.0f} % | "
                    f"{r['forces %']:.0f} % | {r['correct %']:.0f} % | {r['contacts/particle']:.2f} | {r['bytes/particle']:.0f} |")
     million = a.folder / "million.json"
     mtime = a.folder / "million_time.txt"

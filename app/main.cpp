@@ -232,7 +232,7 @@ int cmd_compare(const std::string& scene, const std::string& variants, std::int6
 
 // ---- demmat bench --------------------------------------------------------------------------------------
 struct BenchArgs {
-    std::string scene, variants = "all", json_file;
+    std::string scene, variants = "all", json_file, threads = "0";
     std::int64_t steps = 200, repetitions = 5, warmup = 20;
     bool allow_unstable = false;
 };
@@ -244,22 +244,61 @@ double median(std::vector<double> v)
     return v.size() % 2 ? v[m] : 0.5 * (v[m - 1] + v[m]);
 }
 
+// `--threads 1,2`: the thread counts to time; 0 stands for OpenMP's default (OMP_NUM_THREADS, else all cores).
+std::vector<int> thread_counts(const std::string& spec)
+{
+    const int fallback = max_threads();
+    std::vector<int> out;
+    for (const std::string& item : split_list(spec)) {
+        std::size_t used = 0;
+        int t = -1;
+        try {
+            t = std::stoi(item, &used);
+        } catch (const std::exception&) {
+            used = 0;
+        }
+        if (used != item.size() || t < 0 || t > 4096) throw Error(fmt::format("--threads: '{}' is not a thread count (0 to 4096)", item));
+        if (t == 0) t = fallback;
+        if (std::find(out.begin(), out.end(), t) != out.end()) throw Error(fmt::format("--threads: {} thread(s) named twice", t));
+        out.push_back(t);
+    }
+    if (out.empty()) throw Error("no thread count in --threads");
+    return out;
+}
+
+// One timed configuration: a variant at a thread count (a variant that is not threaded runs once, at 1).
+struct BenchConfig {
+    std::string variant;
+    int threads;
+    std::string label() const { return fmt::format("{}@{}", variant, threads); }
+};
+
 int cmd_bench(const BenchArgs& a)
 {
     auto l = load(a.scene, a.allow_unstable);
     const auto names = variant_list(a.variants);
+    const std::vector<int> counts_asked = thread_counts(a.threads);
+    std::vector<BenchConfig> configs;
+    for (const auto& name : names) {
+        if (!registry().find(name).threaded) configs.push_back({name, 1});
+        else
+            for (const int t : counts_asked) configs.push_back({name, t});
+    }
     const char* phases[] = {"predict", "search", "forces", "correct"};
-    // samples[variant][phase] = seconds per step, one per repetition
+    // samples[config][phase] = seconds per step, one per repetition
     std::map<std::string, std::map<std::string, std::vector<double>>> samples;
     std::map<std::string, ContactCounts> counts;
     std::map<std::string, std::size_t> memory;
     std::map<std::string, std::string> model;  // the model instantiation each variant picked
     json reps = json::array();
     for (std::int64_t r = 0; r < a.repetitions; ++r) {
-        // Interleaved, with the order rotated each repetition, so drift of a shared machine hits all alike.
-        for (std::size_t q = 0; q < names.size(); ++q) {
-            const std::string& name = names[(q + std::size_t(r)) % names.size()];
-            auto variant = registry().find(name).create();
+        // Interleaved, variants and thread counts alike, with the order rotated each repetition, so that
+        // drift of a shared machine hits all alike (a speed-up is then a ratio of samples taken side by side).
+        for (std::size_t q = 0; q < configs.size(); ++q) {
+            const BenchConfig& cfg = configs[(q + std::size_t(r)) % configs.size()];
+            const std::string key = cfg.label();
+            set_threads(cfg.threads);
+            auto variant = registry().find(cfg.variant).create();
             Driver driver(*variant, l->setup);
             for (std::int64_t k = 0; k < a.warmup; ++k) driver.step();
             const PhaseTimes before = driver.times();
@@ -269,53 +308,57 @@ int cmd_bench(const BenchArgs& a)
             const double v[4] = {(after.predict - before.predict) * per, (after.search - before.search) * per,
                                  (after.forces - before.forces) * per, (after.correct - before.correct) * per};
             for (int p = 0; p < 4; ++p) {
-                samples[name][phases[p]].push_back(v[p]);
-                reps.push_back({{"variant", name}, {"repetition", r}, {"phase", phases[p]}, {"seconds_per_step", v[p]}});
+                samples[key][phases[p]].push_back(v[p]);
+                reps.push_back({{"variant", cfg.variant},
+                                {"threads", cfg.threads},
+                                {"repetition", r},
+                                {"phase", phases[p]},
+                                {"seconds_per_step", v[p]}});
             }
-            counts[name] = variant->counts();
-            memory[name] = variant->memory_bytes();
-            model[name] = variant->model().name();
+            counts[key] = variant->counts();
+            memory[key] = variant->memory_bytes();
+            model[key] = variant->model().name();
         }
         std::cerr << fmt::format("demmat bench: repetition {}/{} done\n", r + 1, a.repetitions);
     }
     json summary = json::array();
     const double n = double(l->state.size());
-    std::cout << fmt::format("{:<16} {:>12} {:>12} {:>12} {:>12} {:>12} {:>10}\n", "variant", "predict", "search", "forces",
-                             "correct", "total", "us/p-step");
-    for (const auto& name : names) {
+    std::cout << fmt::format("{:<16} {:>7} {:>12} {:>12} {:>12} {:>12} {:>12} {:>10}\n", "variant", "threads", "predict", "search",
+                             "forces", "correct", "total", "us/p-step");
+    for (const auto& cfg : configs) {
+        const std::string key = cfg.label();
         json ph;
-        double total = 0.0;
         std::vector<double> totals(std::size_t(a.repetitions), 0.0);
         for (const char* p : phases) {
-            const auto& s = samples[name][p];
+            const auto& s = samples[key][p];
             ph[p] = {{"median", median(s)}, {"min", *std::min_element(s.begin(), s.end())}, {"max", *std::max_element(s.begin(), s.end())}};
-            total += median(s);
             for (std::size_t r = 0; r < s.size(); ++r) totals[r] += s[r];
         }
         const double tot_med = median(totals);
         ph["total"] = {{"median", tot_med}, {"min", *std::min_element(totals.begin(), totals.end())},
                        {"max", *std::max_element(totals.begin(), totals.end())}};
-        const ContactCounts& c = counts[name];
-        summary.push_back({{"variant", name},
+        const ContactCounts& c = counts[key];
+        summary.push_back({{"variant", cfg.variant},
+                           {"threads", cfg.threads},
                            {"seconds_per_step", ph},
                            {"us_per_particle_step", tot_med / n * 1e6},
                            {"contacts_per_particle", (2.0 * double(c.particle_particle) + double(c.particle_wall)) / n},
-                           {"memory_bytes", memory[name]},
-                           {"model", model[name]}});
-        std::cout << fmt::format("{:<16} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e} {:>10.4f}\n", name,
+                           {"memory_bytes", memory[key]},
+                           {"model", model[key]}});
+        std::cout << fmt::format("{:<16} {:>7} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e} {:>10.4f}\n", cfg.variant, cfg.threads,
                                  ph["predict"]["median"].get<double>(), ph["search"]["median"].get<double>(),
                                  ph["forces"]["median"].get<double>(), ph["correct"]["median"].get<double>(), tot_med,
                                  tot_med / n * 1e6);
     }
-    std::cout << "(seconds per step, medians over " << a.repetitions << " interleaved repetitions of " << a.steps << " steps; "
-              << max_threads() << " thread(s) for the threaded variants)\n";
+    std::cout << "(seconds per step, medians over " << a.repetitions << " interleaved repetitions of " << a.steps
+              << " steps; the variants that are not threaded run on 1 thread)\n";
     if (!a.json_file.empty()) {
         json j = {{"provenance", provenance_json()},
                   {"scene", scene_json(*l)},
                   {"steps", a.steps},
                   {"warmup_steps", a.warmup},
                   {"repetitions", a.repetitions},
-                  {"threads", max_threads()},
+                  {"thread_counts", counts_asked},
                   {"summary", summary},
                   {"samples", reps}};
         write_atomically(a.json_file, j.dump(2) + "\n");
@@ -421,7 +464,8 @@ int main(int argc, char** argv)
     bench->add_option("--warmup", ba.warmup, "Untimed steps before each repetition")->check(CLI::NonNegativeNumber);
     bench->add_option("--json", ba.json_file, "Write the samples and medians as JSON with provenance");
     bench->add_flag("--allow-unstable", ba.allow_unstable, "Run even with a time step above the Rayleigh time, without warning");
-    bench->add_option("--threads", threads, threads_help)->check(CLI::NonNegativeNumber);
+    bench->add_option("--threads", ba.threads,
+                      "Comma-separated thread counts for the threaded variants, timed interleaved (e.g. 1,2); 0: OpenMP's default");
 
     remove_partial_files_on_signal();
     try {

@@ -3,7 +3,7 @@
 # (0.4 s simulated with fast on every core, kept in states/), then `demmat bench` of arrays, fast and
 # fast_unordered on the settled bed (walls at rest) at each thread count, interleaved repetitions,
 # medians; then 10^6 particles run a few steps to show they fit (peak memory from /usr/bin/time).
-# Writes results/fast/bench_settled_<N>_t<threads>.json (+ .txt), results/fast/million.txt and the table
+# Writes results/fast/bench_settled_<N>.json (+ .txt; every thread count, interleaved), results/fast/million.txt and the table
 # results/fast/summary.md (analysis/summarise_fast.py).
 # Usage: scripts/bench_fast.sh [--sizes "1000 10000 100000"] [--threads "1 2"] [--repetitions R]
 #                              [--settle-time T] [--no-million] [--settle-only] [--build DIR]
@@ -49,12 +49,13 @@ for n in $sizes; do
   # The settled bed continuing from its state, walls at rest (a compression stage of speed 0).
   [[ -f "$settled" ]] || $demmat scene compression --from "$bed" --state "$state" --speed 0 -o "$settled"
   steps=$(( 5000000 / n )); (( steps < 20 )) && steps=20
-  for t in $threads; do
-    echo "== N = $n, $t thread(s): $reps interleaved repetitions of $steps steps"
-    out=results/fast/bench_settled_${n}_t${t}
-    $demmat bench "$settled" --variants arrays,fast,fast_unordered --steps "$steps" --warmup 10 \
-      --repetitions "$reps" --threads "$t" --json "$out.json" | tee "$out.txt"
-  done
+  # Every thread count in one run, interleaved with the variants, so that the speed-up compares samples
+  # taken side by side (separate runs met different moods of the shared machine).
+  echo "== N = $n, threads ${threads// /,}: $reps interleaved repetitions of $steps steps"
+  out=results/fast/bench_settled_${n}
+  rm -f "$out"_t*.json "$out"_t*.txt  # the earlier layout, one run per thread count
+  $demmat bench "$settled" --variants arrays,fast,fast_unordered --steps "$steps" --warmup 10 \
+    --repetitions "$reps" --threads "${threads// /,}" --json "$out.json" | tee "$out.txt"
 done
 [[ $settle_only == 1 ]] && exit 0
 
