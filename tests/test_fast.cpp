@@ -130,6 +130,31 @@ TEST(Fast, AnySkinAndThreadCountGiveTheSameTrajectory)
     EXPECT_LT(r.rebuilds[1], steps / 20);
 }
 
+TEST(Fast, MoreWallsThanTheNearWallBitsGiveTheSameTrajectory)
+{
+    // fast marks the walls a grain may touch a bit per wall up to 8 walls and tests each wall again
+    // beyond. Four walls that touch nothing (the side walls moved 5 cm out) put in front of the box's
+    // six make ten, with the floor (z_min, the most contacts) at index 8, past the bits.
+    Case c = bed_case(0.5);
+    Scene s = c.scene;
+    State st = c.state;
+    std::vector<Wall> far;
+    for (const Wall& w : st.walls) {
+        if (w.name == "z_min" || w.name == "z_max") continue;
+        Wall out = w;
+        out.name = w.name + "_far";
+        out.point = w.point - 0.05 * w.normal;
+        far.push_back(out);
+    }
+    ASSERT_EQ(far.size(), 4u);
+    st.walls.insert(st.walls.begin(), far.begin(), far.end());
+    s.walls.insert(s.walls.begin(), far.begin(), far.end());
+    ASSERT_EQ(st.walls[8].name, "z_min");
+    Case many(s, st);
+    const auto r = lockstep(many.setup, 300, {{FastOptions{}, 1}, {FastOptions{}, 2}});
+    EXPECT_EQ(r.difference, "");
+}
+
 TEST(Fast, UnorderedDiffersFromArraysOnlyByTheSummationOrder)
 {
     // One step from the settled bed: the contact set is the same, only each particle's sum is taken in

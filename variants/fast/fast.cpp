@@ -363,6 +363,7 @@ private:
     using Lanes = Pack<T, native_lanes<T>>;
     static constexpr int kLanes = native_lanes<T>;
     static constexpr std::size_t kBlock = 512;
+    static constexpr std::size_t kWallBits = 8;  // near_wall_ holds a bit per wall up to this many walls
 
     // Slots [k0, k1) (owner s, partner q): the contacts among them, each into its slot (canonical mode,
     // where touch[k] then says whether slot k holds a contact) or added to the loads `load` of both
@@ -585,8 +586,9 @@ private:
         return {n * t / nt, n * (t + 1) / nt};
     }
 
-    // near_wall[s] for s in [lo, hi): may s touch any wall (may_touch_wall, vectorised over the
-    // particles, a wall at a time)? Only those are tested wall by wall; in a bed most touch none. A scene
+    // near_wall[s] for s in [lo, hi): which walls may s touch (may_touch_wall, vectorised over the
+    // particles, a wall at a time)? Bit w for wall w in a scene of at most kWallBits walls; else one bit
+    // for any, and the candidates test each wall again. Only those are tested wall by wall; in a bed most touch none. A scene
     // has a handful of walls: testing each every step costs less than a wall list, and keeps the moving
     // wall out of the rebuild criterion.
     void mark_walls(std::size_t lo, std::size_t hi)
@@ -603,9 +605,10 @@ private:
             const std::size_t c1 = std::min(hi, c0 + chunk);
             for (std::size_t w = 0; w < nw_; ++w) {
                 const Vec3<T> p = wall_point(w), nrm = wall_normal(w);
+                const int bit = nw_ <= kWallBits ? int(w) : 0;
 #pragma omp simd
                 for (std::size_t s = c0; s < c1; ++s)
-                    near[s] |= std::uint8_t(may_touch_wall(Vec3<T>{x[s], x[n + s], x[2 * n + s]}, r[s], p, nrm));
+                    near[s] |= std::uint8_t(std::uint8_t(may_touch_wall(Vec3<T>{x[s], x[n + s], x[2 * n + s]}, r[s], p, nrm)) << bit);
             }
         }
     }
@@ -645,6 +648,10 @@ private:
         const std::uint8_t* near = near_wall_.data();
         for (std::size_t s = lo; s < hi; ++s) {
             if (!near[s]) continue;
+            if (nw_ <= kWallBits) {  // the walls are the bits, ascending
+                for (unsigned m = near[s]; m != 0; m &= m - 1) cand.push_back({Index(s), Index(__builtin_ctz(m))});
+                continue;
+            }
             const Quad<T> xr = kin_[s].xr;
             for (std::size_t w = 0; w < nw_; ++w)
                 if (may_touch_wall(Vec3<T>{xr[0], xr[1], xr[2]}, xr[3], wall_point(w), wall_normal(w))) cand.push_back({Index(s), Index(w)});
@@ -1020,7 +1027,7 @@ private:
     std::vector<Slot<T>> slot_;
     std::vector<std::uint8_t> touch_;         // each listed pair: in contact this step (then slot_ holds it; canonical)
     std::vector<Kin<T>> kin_;                 // (N) the kernel's copy of x, R, v, ω
-    std::vector<std::uint8_t> near_wall_;   // (N) may touch a wall this step
+    std::vector<std::uint8_t> near_wall_;   // (N) the walls it may touch this step (a bit each, see mark_walls)
     std::vector<std::vector<WallCandidate>> wall_cand_;  // per thread: the particle–wall pairs that may touch
     std::vector<std::vector<Load<T>>> wall_res_;         // per thread: their force and torque (zeros: no contact)
     std::vector<Key> key_, keytmp_;
