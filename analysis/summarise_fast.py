@@ -21,18 +21,18 @@ def load(folder):
     interleaved); also the paired speed-ups: per repetition, the 1-thread total over the t-thread total
     of the same variant, taken side by side."""
     rows, paired, prov = [], [], None
-    for path in sorted(folder.glob("bench_settled_*.json")):
-        m = re.fullmatch(r"bench_settled_(\d+)\.json", path.name)
+    for path in sorted(folder.glob("bench_*.json")):
+        m = re.fullmatch(r"bench_(settled|loose)_(\d+)\.json", path.name)
         if not m:
             continue
         d = json.loads(path.read_text())
         prov = prov or d["provenance"]
-        n = int(m.group(1))
+        state, n = m.group(1), int(m.group(2))
         for s in d["summary"]:
             sec = s["seconds_per_step"]
             total = sec["total"]["median"]
             rows.append({
-                "N": n, "threads": int(s["threads"]), "variant": s["variant"],
+                "state": state, "N": n, "threads": int(s["threads"]), "variant": s["variant"],
                 "us_per_particle_step": s["us_per_particle_step"],
                 "min_us": sec["total"]["min"] / d["scene"]["particles"] * 1e6,
                 "max_us": sec["total"]["max"] / d["scene"]["particles"] * 1e6,
@@ -47,7 +47,7 @@ def load(folder):
                 if t != 1:
                     ratio = (tot[1] / tot[t]).dropna()
                     for v, r in ratio.groupby(level="variant"):
-                        paired.append({"N": n, "variant": v, "threads": int(t), "paired": r.median(), "paired_min": r.min(), "paired_max": r.max()})
+                        paired.append({"state": state, "N": n, "variant": v, "threads": int(t), "paired": r.median(), "paired_min": r.min(), "paired_max": r.max()})
     return pd.DataFrame(rows), pd.DataFrame(paired), prov
 
 
@@ -60,32 +60,34 @@ def main(argv):
     if df.empty:
         print(f"summarise_fast.py: no bench_settled_<N>.json in {a.folder}", file=sys.stderr)
         return 1
-    df = df.sort_values(["N", "variant", "threads"])
-    one = df[df.threads == 1].set_index(["N", "variant"])["us_per_particle_step"]
-    df["speed-up vs 1 thread"] = [one.get((n, v), float("nan")) / u for n, v, u in zip(df.N, df.variant, df.us_per_particle_step)]
-    arrays1 = df[(df.variant == "arrays") & (df.threads == 1)].set_index("N")["us_per_particle_step"]
-    df["vs arrays (1 thread)"] = [u / arrays1.get(n, float("nan")) for n, u in zip(df.N, df.us_per_particle_step)]
+    df["state order"] = df.state.map({"settled": 0, "loose": 1})
+    df = df.sort_values(["state order", "N", "variant", "threads"])
+    one = df[df.threads == 1].set_index(["state", "N", "variant"])["us_per_particle_step"]
+    df["speed-up vs 1 thread"] = [one.get((st, n, v), float("nan")) / u for st, n, v, u in zip(df.state, df.N, df.variant, df.us_per_particle_step)]
+    arrays1 = df[(df.variant == "arrays") & (df.threads == 1)].set_index(["state", "N"])["us_per_particle_step"]
+    df["vs arrays (1 thread)"] = [u / arrays1.get((st, n), float("nan")) for st, n, u in zip(df.state, df.N, df.us_per_particle_step)]
 
     out = [
-        "# fast on the settled bed: N, threads, canonical order",
+        "# fast against N, threads and the canonical order",
         "",
         f"Produced by scripts/bench_fast.sh and analysis/summarise_fast.py: commit {prov['commit'][:10]}"
         f"{' (dirty)' if prov.get('dirty') else ''}, {prov['compiler']}, `{prov['flags']}`, CPU {prov['cpu']}, {prov['date']}.",
-        "Median µs per particle-step over interleaved repetitions (min–max); phases as % of the step; the"
-        " dense bed settled 0.4 s by fast, then continued with the walls at rest. Every thread count of an N"
+        "Median µs per particle-step over interleaved repetitions (min–max); phases as % of the step."
+        " *settled*: the dense bed settled 0.4 s by fast, then continued with the walls at rest; *loose*: the"
+        " bed's loose lattice at t = 0 (no contacts yet: 10⁶ grains would take hours to settle). Every thread count of an N"
         " ran in one `demmat bench`, interleaved with the variants; the speed-up is the ratio of the medians,"
         " the paired speed-up the median (min–max) over the repetitions of each repetition's own ratio, its"
         " two samples taken side by side. `arrays` is not threaded and runs once, at 1 thread.",
         "",
-        "| N | variant | threads | µs/particle-step | min–max | speed-up vs 1 thread | paired speed-up | vs arrays (1 thread) | predict | search | forces | correct | contacts/particle | bytes/particle |",
-        "|---:|---|---:|---:|---|---:|---|---:|---:|---:|---:|---:|---:|---:|",
+        "| state | N | variant | threads | µs/particle-step | min–max | speed-up vs 1 thread | paired speed-up | vs arrays (1 thread) | predict | search | forces | correct | contacts/particle | bytes/particle |",
+        "|---|---:|---|---:|---:|---|---:|---|---:|---:|---:|---:|---:|---:|---:|",
     ]
-    pair = paired.set_index(["N", "variant", "threads"]) if not paired.empty else None
+    pair = paired.set_index(["state", "N", "variant", "threads"]) if not paired.empty else None
     for _, r in df.iterrows():
-        key = (r["N"], r["variant"], r["threads"])
+        key = (r["state"], r["N"], r["variant"], r["threads"])
         p = f"{pair.loc[key, 'paired']:.2f} ({pair.loc[key, 'paired_min']:.2f}–{pair.loc[key, 'paired_max']:.2f})" \
             if pair is not None and key in pair.index else ""
-        out.append(f"| {r['N']} | {r['variant']} | {r['threads']} | {r['us_per_particle_step']:.3f} | {r['min_us']:.3f}–{r['max_us']:.3f} | "
+        out.append(f"| {r['state']} | {r['N']} | {r['variant']} | {r['threads']} | {r['us_per_particle_step']:.3f} | {r['min_us']:.3f}–{r['max_us']:.3f} | "
                    f"{r['speed-up vs 1 thread']:.2f} | {p} | {r['vs arrays (1 thread)']:.2f} | {r['predict %']:.0f} % | {r['search %']:.0f} % | "
                    f"{r['forces %']:.0f} % | {r['correct %']:.0f} % | {r['contacts/particle']:.2f} | {r['bytes/particle']:.0f} |")
     million = a.folder / "million.json"
