@@ -587,10 +587,10 @@ private:
     }
 
     // near_wall[s] for s in [lo, hi): which walls may s touch (may_touch_wall, vectorised over the
-    // particles, a wall at a time)? Bit w for wall w in a scene of at most kWallBits walls; else one bit
-    // for any, and the candidates test each wall again. Only those are tested wall by wall; in a bed most touch none. A scene
-    // has a handful of walls: testing each every step costs less than a wall list, and keeps the moving
-    // wall out of the rebuild criterion.
+    // particles, a wall at a time)? Bit w for wall w in a scene of at most kWallBits walls; beyond, one
+    // bit for any, and the candidates test each wall again for the particles marked (in a bed most touch
+    // none). A scene has a handful of walls: testing each every step costs less than a wall list, and
+    // keeps the moving wall out of the rebuild criterion.
     void mark_walls(std::size_t lo, std::size_t hi)
     {
         const std::size_t n = n_;
