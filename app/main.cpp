@@ -323,7 +323,9 @@ int cmd_bench(const BenchArgs& a)
     }
     json summary = json::array();
     const double n = double(l->state.size());
-    std::cout << fmt::format("{:<16} {:>7} {:>12} {:>12} {:>12} {:>12} {:>12} {:>10}\n", "variant", "threads", "predict", "search",
+    std::size_t width = 7;  // the longest variant name, so that the columns line up
+    for (const auto& cfg : configs) width = std::max(width, cfg.variant.size());
+    std::cout << fmt::format("{:<{}} {:>7} {:>12} {:>12} {:>12} {:>12} {:>12} {:>10}\n", "variant", width, "threads", "predict", "search",
                              "forces", "correct", "total", "us/p-step");
     for (const auto& cfg : configs) {
         const std::string key = cfg.label();
@@ -345,7 +347,7 @@ int cmd_bench(const BenchArgs& a)
                            {"contacts_per_particle", (2.0 * double(c.particle_particle) + double(c.particle_wall)) / n},
                            {"memory_bytes", memory[key]},
                            {"model", model[key]}});
-        std::cout << fmt::format("{:<16} {:>7} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e} {:>10.4f}\n", cfg.variant, cfg.threads,
+        std::cout << fmt::format("{:<{}} {:>7} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e} {:>10.4f}\n", cfg.variant, width, cfg.threads,
                                  ph["predict"]["median"].get<double>(), ph["search"]["median"].get<double>(),
                                  ph["forces"]["median"].get<double>(), ph["correct"]["median"].get<double>(), tot_med,
                                  tot_med / n * 1e6);
