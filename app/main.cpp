@@ -259,6 +259,7 @@ std::vector<int> thread_counts(const std::string& spec)
         }
         if (used != item.size() || t < 0 || t > 4096) throw Error(fmt::format("--threads: '{}' is not a thread count (0 to 4096)", item));
         if (t == 0) t = fallback;
+        if (t > 1 && !openmp_enabled()) throw Error(fmt::format("--threads: {} threads asked, but this build has no OpenMP", t));
         if (std::find(out.begin(), out.end(), t) != out.end()) throw Error(fmt::format("--threads: {} thread(s) named twice", t));
         out.push_back(t);
     }
