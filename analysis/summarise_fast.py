@@ -20,14 +20,14 @@ def load(folder):
     """One row per (N, variant, threads) from bench_settled_<N>.json (every thread count in one run,
     interleaved); also the paired speed-ups: per repetition, the 1-thread total over the t-thread total
     of the same variant, taken side by side."""
-    rows, paired, prov = [], [], None
+    rows, paired, prov = [], [], {}
     for path in sorted(folder.glob("bench_*.json")):
         m = re.fullmatch(r"bench_(settled|loose)_(\d+)\.json", path.name)
         if not m:
             continue
         d = json.loads(path.read_text())
-        prov = prov or d["provenance"]
         state, n = m.group(1), int(m.group(2))
+        prov.setdefault(state, {})[n] = d["provenance"]
         for s in d["summary"]:
             sec = s["seconds_per_step"]
             total = sec["total"]["median"]
@@ -51,6 +51,19 @@ def load(folder):
     return pd.DataFrame(rows), pd.DataFrame(paired), prov
 
 
+def provenance_line(prov):
+    """Each state's runs with their commit, compiler, flags, CPU and dates (the states may come from
+    different runs: bench_fast.sh --sizes "" reruns only the loose lattice of 10⁶)."""
+    parts = []
+    for state, by_n in prov.items():
+        first = next(iter(by_n.values()))
+        commits = sorted({p["commit"][:10] + (" (dirty)" if p.get("dirty") else "") for p in by_n.values()})
+        dates = sorted(p["date"] for p in by_n.values())
+        parts.append(f"*{state}* N = {', '.join(str(n) for n in sorted(by_n))}: commit {', '.join(commits)}, {first['compiler']}, "
+                     f"`{first['flags']}`, CPU {first['cpu']}, {dates[0]}" + (f" to {dates[-1]}" if dates[-1] != dates[0] else ""))
+    return "; ".join(parts) + "."
+
+
 def main(argv):
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("folder", type=pathlib.Path)
@@ -70,8 +83,7 @@ def main(argv):
     out = [
         "# fast against N, threads and the canonical order",
         "",
-        f"Produced by scripts/bench_fast.sh and analysis/summarise_fast.py: commit {prov['commit'][:10]}"
-        f"{' (dirty)' if prov.get('dirty') else ''}, {prov['compiler']}, `{prov['flags']}`, CPU {prov['cpu']}, {prov['date']}.",
+        "Produced by scripts/bench_fast.sh and analysis/summarise_fast.py; " + provenance_line(prov),
         "Median µs per particle-step over interleaved repetitions (min–max); phases as % of the step."
         " *settled*: the dense bed settled 0.4 s by fast, then continued with the walls at rest; *loose*: the"
         " bed's loose lattice at t = 0 (no contacts yet: 10⁶ grains would take hours to settle). Every thread count of an N"
