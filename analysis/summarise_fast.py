@@ -17,8 +17,8 @@ from atomic_io import write_text
 
 
 def load(folder):
-    """One row per (N, variant, threads) from bench_settled_<N>.json (every thread count in one run,
-    interleaved); also the paired speed-ups: per repetition, the 1-thread total over the t-thread total
+    """One row per (state, N, variant, threads) from bench_settled_<N>.json and bench_loose_<N>.json
+    (every thread count in one run, interleaved); also the paired speed-ups: per repetition, the 1-thread total over the t-thread total
     of the same variant, taken side by side."""
     rows, paired, prov = [], [], {}
     for path in sorted(folder.glob("bench_*.json")):
@@ -71,7 +71,7 @@ def main(argv):
     a = ap.parse_args(argv)
     df, paired, prov = load(a.folder)
     if df.empty:
-        print(f"summarise_fast.py: no bench_settled_<N>.json in {a.folder}", file=sys.stderr)
+        print(f"summarise_fast.py: no bench_settled_<N>.json or bench_loose_<N>.json in {a.folder}", file=sys.stderr)
         return 1
     df["state order"] = df.state.map({"settled": 0, "loose": 1})
     df = df.sort_values(["state order", "N", "variant", "threads"])

@@ -666,13 +666,14 @@ private:
     std::int64_t wall_contacts()
     {
         const std::size_t nt = std::size_t(thread_count());
+        auto packs_of = [this](std::size_t u) { return (wall_cand_[u].size() + kLanes - 1) / kLanes; };
         std::size_t packs = 0;
-        for (std::size_t u = 0; u < nt; ++u) packs += (wall_cand_[u].size() + kLanes - 1) / kLanes;
+        for (std::size_t u = 0; u < nt; ++u) packs += packs_of(u);
         std::int64_t found = 0;
 #pragma omp for schedule(static) nowait
         for (std::size_t p = 0; p < packs; ++p) {
             std::size_t u = 0, first = 0;  // the list that pack p falls in, and its first pack
-            while (p >= first + (wall_cand_[u].size() + kLanes - 1) / kLanes) first += (wall_cand_[u++].size() + kLanes - 1) / kLanes;
+            while (p >= first + packs_of(u)) first += packs_of(u++);
             const std::size_t e = (p - first) * kLanes, count = std::min<std::size_t>(kLanes, wall_cand_[u].size() - e);
             found += pack_of_walls(wall_cand_[u].data() + e, int(count), wall_res_[u].data() + e);
         }
