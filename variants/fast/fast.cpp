@@ -1,18 +1,21 @@
 // The fast variant: data-oriented, vectorised, OpenMP multi-threaded, and still bit-identical to arrays
 // for any number of threads (docs/variants.md, "fast").
 //
-// - Particles live in cell order (re-sorted at every neighbour-list rebuild) with their ids kept; the
-//   state is a structure of arrays, each vector quantity three contiguous component blocks (x then y
-//   then z) as in arrays, so the Gear predictor and corrector are single vectorised streams over 3N.
+// - Particles live in cell order (re-sorted at every neighbour-list rebuild, the box's shortest axis
+//   fastest) with their ids kept; the state is a structure of arrays, each vector quantity three
+//   contiguous component blocks (x then y then z) as in arrays, so the Gear predictor and corrector are
+//   single vectorised streams over 3N.
 // - The contact candidates come from a neighbour list with a skin, rebuilt only when a displacement
 //   check says it must be. The list is a superset of the contact set and the shared law alone decides
 //   h > 0, so the contacts, and with the canonical order the trajectory, are those of a search every step.
-// - The list holds each pair once, under its lower-id particle (the law's i), partners sorted by id, in
-//   one array of slots kept across steps. The pair kernel writes each contact's force and torques into
-//   its slot (any thread, any order); then each particle gathers, in the canonical order of physics.md
-//   §6, the slots where it is j (partners of lower id, ascending; a list also kept across steps), then
-//   its own slots (partners of higher id, ascending, contiguous), then its walls, and applies Newton's
-//   law. No sum depends on which thread did what, so the bits do not depend on the thread count.
+// - The list holds each pair once, under its lower-id particle (the law's i), partners sorted by id. The
+//   pair kernel writes each contact's force and torques into its slot; each particle then gathers, in
+//   the canonical order of physics.md §6, the slots where it is j (partners of lower id, ascending; a
+//   list kept across steps), then its own slots (partners of higher id, ascending, contiguous), then its
+//   walls, and applies Newton's law. Kernel and sums go in one sweep over the storage order, a chunk of
+//   particles at a time, and the sums read the slots from a small ring that stays in cache (see
+//   forces_canonical). No sum depends on which thread did what, so the bits do not depend on the
+//   thread count.
 // - The kernel reads each particle's position, radius, velocity and angular velocity from one record
 //   (Kin, refreshed at the start of the force pass) and moves a pack's worth between records and lanes
 //   by transposes of whole vectors.
@@ -23,6 +26,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <bit>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -61,6 +65,20 @@ using Index = std::int32_t;
 template <class T>
 struct Slot {
     Vec3<T> f, ti, tj;
+};
+
+// Where the canonical kernel puts slot k: ring[k & mask], a thread's ring of the slots its sweep has yet
+// to sum, and, where `all` is set, all[k] too (the whole list, for the sums that straddle two pieces).
+template <class T>
+struct SlotSink {
+    Slot<T>* ring = nullptr;
+    std::size_t mask = 0;
+    Slot<T>* all = nullptr;
+    void put(std::size_t k, const Slot<T>& v) const
+    {
+        ring[k & mask] = v;
+        if (all) all[k] = v;
+    }
 };
 
 // Four values loaded and stored as one vector (32 bytes for double): the unit of the kernel's transposes.
@@ -206,6 +224,7 @@ public:
         place_walls(step_);
         pstart_.assign(n_ + 1, 0);
         near_wall_.assign(n_, 0);
+        wall_first_.assign(n_, 0);
         kin_.resize(n_);
         lstart_.assign(n_ + 1, 0);
         key_.resize(n_);
@@ -326,15 +345,19 @@ public:
         for (const auto* arr : {&x_, &v_, &a_, &b3_, &b4_, &b5_, &th_, &w_, &al_, &r3_, &r4_, &r5_, &f_, &t_, &acc_, &alc_, &xref_, &tmp_,
                                 &r_, &m_, &I_, &tmp1_})
             b += arr->capacity() * sizeof(T);
-        for (const auto* arr : {&id_, &pos_, &tmpi_, &pstart_, &partner_, &owner_, &lstart_, &lslot_, &cstart_})
+        for (const auto* arr : {&id_, &pos_, &tmpi_, &pstart_, &partner_, &owner_, &lstart_, &lslot_, &cstart_, &wall_first_, &first_chunk_,
+                                &sum_start_, &sum_order_})
             b += arr->capacity() * sizeof(Index);
-        b += slot_.capacity() * sizeof(Slot<T>) + touch_.capacity() + near_wall_.capacity();
+        b += slot_.capacity() * sizeof(Slot<T>) + near_wall_.capacity();
+        for (const auto& r : rings_) b += r.capacity() * sizeof(Slot<T>);
         b += kin_.capacity() * sizeof(Kin<T>);
         b += (key_.capacity() + keytmp_.capacity()) * sizeof(Key) + cell3_.capacity() * sizeof(std::int64_t);
         for (const auto& l : loads_) b += l.capacity() * sizeof(Load<T>);
         for (const auto& l : wall_res_) b += l.capacity() * sizeof(Load<T>);
         for (const auto& l : wall_cand_) b += l.capacity() * sizeof(WallCandidate);
         for (const auto& v : scan_) b += v.capacity() * sizeof(Index);
+        for (const auto& v : leftover_) b += v.capacity() * sizeof(Index);
+        b += piece_chunk_.capacity() * sizeof(std::size_t);
         b += ncursors_ * sizeof(BlockCursor);
         return b;
     }
@@ -358,24 +381,28 @@ private:
         }
     }
 
-    // The law runs on packs of kLanes candidates (the widest vector the target has); the slots are
-    // shared out among the threads in blocks of kBlock.
+    // The law runs on packs of kLanes candidates (the widest vector the target has), sorted kBlock
+    // candidates at a time (slots_of).
     using Lanes = Pack<T, native_lanes<T>>;
     static constexpr int kLanes = native_lanes<T>;
-    static constexpr std::size_t kBlock = 512;
+    static constexpr std::size_t kBlock = 1024;
     static constexpr std::size_t kWallBits = 8;  // near_wall_ holds a bit per wall up to this many walls
+    // The canonical sweep (forces_canonical) goes a chunk of kChunk particles at a time, in pieces of
+    // kPiecesPerThread per thread when there are several (settled bed of 10^5, 2 threads: 1, 2 and 4
+    // pieces per thread took the same time within the noise; more pieces, more sums that straddle two).
+    static constexpr std::size_t kChunk = 128;
+    static constexpr std::size_t kPiecesPerThread = 2;
 
     // Slots [k0, k1) (owner s, partner q): the contacts among them, each into its slot (canonical mode,
-    // where touch[k] then says whether slot k holds a contact) or added to the loads `load` of both
-    // particles (unordered mode). A canonical sum reads every slot of a particle, so there a pair out of
-    // contact holds zeros, which add nothing (a sum that starts at +0 is never -0, and x + ±0 = x for
-    // every other x), so the bits are those of arrays, which skips the pair; reading zeros costs less than
-    // a branch that is taken at random. may_touch first, a cheap and conservative test (the law rejects
+    // through `sink`) or added to the loads `load` of both particles (unordered mode). A canonical sum
+    // reads every slot of a particle, so there a pair out of contact holds zeros, which add nothing (a sum
+    // that starts at +0 is never -0, and x + ±0 = x for every other x), so the bits are those of arrays,
+    // which skips the pair; reading zeros costs less than a branch that is taken at random. may_touch first, a cheap and conservative test (the law rejects
     // every pair it rejects), so the skin's extra candidates cost a distance, not a pass through the law;
     // the rest go through the law kLanes at a time. The test sorts the slots into kept and dropped
     // without a branch (a third are dropped, in no pattern a predictor learns). Returns the contacts found.
     template <bool Canonical>
-    std::int64_t slots_of(std::size_t k0, std::size_t k1, Load<T>* load)
+    std::int64_t slots_of(std::size_t k0, std::size_t k1, Load<T>* load, const SlotSink<T>& sink = {})
     {
         const Index* owner = owner_.data();
         const Index* partner = partner_.data();
@@ -411,15 +438,10 @@ private:
                 nk += std::size_t(t);
                 nd += std::size_t(!t);
             }
-            // A dropped slot is zeroed when it was not dropped the step before (most stay dropped).
             if constexpr (Canonical)
-                for (std::size_t e = 0; e < nd; ++e) {
-                    const std::size_t k = dropped[e];
-                    if (!touch_[k]) continue;
-                    touch_[k] = 0;
-                    slot_[k] = Slot<T>{};
-                }
-            for (std::size_t e = 0; e < nk; e += kLanes) found += pack_of_slots<Canonical>(kept + e, int(std::min<std::size_t>(kLanes, nk - e)), load);
+                for (std::size_t e = 0; e < nd; ++e) sink.put(dropped[e], Slot<T>{});
+            for (std::size_t e = 0; e < nk; e += kLanes)
+                found += pack_of_slots<Canonical>(kept + e, int(std::min<std::size_t>(kLanes, nk - e)), load, sink);
         }
         return found;
     }
@@ -429,7 +451,7 @@ private:
     // the lanes, particle_contact_lanes, and the lanes transposed back into the slots (zeros where
     // h <= 0) or added to the loads. Each lane's bits are those particle_contact gives for its slot's pair.
     template <bool Canonical>
-    int pack_of_slots(const std::size_t* ks, int count, Load<T>* load)
+    int pack_of_slots(const std::size_t* ks, int count, Load<T>* load, const SlotSink<T>& sink)
     {
         std::size_t k[kLanes], s[kLanes], q[kLanes];
         for (int l = 0; l < kLanes; ++l) {
@@ -469,11 +491,12 @@ private:
             lanes_to_rows<Lanes>(g0, r0);
             lanes_to_rows<Lanes>(g1, r1);
             for (int l = 0; l < count; ++l) {
-                touch_[k[l]] = std::uint8_t(touch[l] != 0);
-                char* out = reinterpret_cast<char*>(&slot_[k[l]]);
-                std::memcpy(out, &r0[l], sizeof(Quad<T>));
-                std::memcpy(out + sizeof(Quad<T>), &r1[l], sizeof(Quad<T>));
-                slot_[k[l]].tj.z = c.t_j.z[l];
+                Slot<T> out;
+                char* bytes = reinterpret_cast<char*>(&out);
+                std::memcpy(bytes, &r0[l], sizeof(Quad<T>));
+                std::memcpy(bytes + sizeof(Quad<T>), &r1[l], sizeof(Quad<T>));
+                out.tj.z = c.t_j.z[l];
+                sink.put(k[l], out);
             }
         } else {
             // Added as they come, lane by lane (a particle may sit in several lanes).
@@ -520,63 +543,129 @@ private:
         const std::size_t n = n_;
         std::int64_t pp = 0, pw = 0;
         const Index* pstart = pstart_.data();
-        const Index* lstart = lstart_.data();
-        const Index* lslot = lslot_.data();
-        const Slot<T>* slot = slot_.data();
-        const std::size_t total = partner_.size(), blocks = (total + kBlock - 1) / kBlock;
+        const Index* sum_start = sum_start_.data();
+        const Index* sum_order = sum_order_.data();
+        const Index* first_chunk = first_chunk_.data();
+        const std::size_t chunks = (n + kChunk - 1) / kChunk, span = span_chunks_;
+        const std::size_t limit = std::size_t(thread_limit());
         per_thread_walls();
         per_thread_cursors();
+        if (leftover_.size() < limit) {
+            leftover_.resize(limit);
+            rings_.resize(limit);
+        }
 #pragma omp parallel reduction(+ : pp, pw) if (par_)
         {
             const auto [lo, hi] = thread_range(n);
             const std::size_t nt = std::size_t(thread_count()), t = std::size_t(thread_index());
-            cursors_[t].next.store(blocks * t / nt, std::memory_order_relaxed);
-            cursors_[t].end = blocks * (t + 1) / nt;
-            WallCursor walls = begin_forces(lo, hi, t);
+            const std::size_t pieces = nt == 1 ? 1 : kPiecesPerThread * nt;
+#pragma omp single
+            {
+                cut_pieces(pieces, chunks);
+                if (pieces > 1) slot_.resize(partner_.size() + 1);  // + 1: a sum reads a quad from the last slot's t_j
+            }
+            cursors_[t].next.store(pieces * t / nt, std::memory_order_relaxed);
+            cursors_[t].end = pieces * (t + 1) / nt;
+            std::vector<Slot<T>>& ring = rings_[t];
+            if (ring.size() < ring_slots_ + 1) ring.assign(ring_slots_ + 1, Slot<T>{});
+            begin_forces(lo, hi, t);
 #pragma omp barrier
             pw += wall_contacts();
-            // Every contact once, into its slot, a block of candidates at a time: first this thread's
-            // share of the blocks, in order, then whatever the others have not yet begun. The halves of a
-            // bed do not cost the same (measured, settled bed of 10^5 at 2 threads: the upper half's
-            // share took 10-20 % longer), and the shared machine slows one core or the other; which thread
-            // computes a slot changes no bit of it.
+#pragma omp barrier
+            // The pair kernel and the canonical sums in one sweep over the storage order, so that each
+            // particle's slots are summed from a ring that stays in cache, not from a list of them all
+            // (at 32000 grains, 10 MB written and read back every step). A piece of the storage is one
+            // thread's, chunk by chunk in order: the chunk's slots, then the sums of the particles whose
+            // last slot (as i or as j) was in it and whose first was in the piece. The others straddle two
+            // pieces: their slots, within span_chunks_ of a piece's ends, also go to slot_, where their
+            // sums read them after the sweep. Pieces are taken a piece at a time: this thread's own first,
+            // then those the others have not begun. Which thread sums a particle, and when, changes no bit.
+            std::vector<Index>& later = leftover_[t];
+            later.clear();
+            const SlotSink<T> in_ring{ring.data(), ring_slots_ - 1, nullptr};
             for (std::size_t k = 0; k < nt; ++k) {
                 BlockCursor& c = cursors_[(t + k) % nt];
-                for (std::size_t b; (b = c.next.fetch_add(1, std::memory_order_relaxed)) < c.end;)
-                    pp += slots_of<true>(b * kBlock, std::min(total, (b + 1) * kBlock), nullptr);
+                for (std::size_t p; (p = c.next.fetch_add(1, std::memory_order_relaxed)) < c.end;) {
+                    const std::size_t c0 = piece_chunk_[p], c1 = piece_chunk_[p + 1];
+                    for (std::size_t ch = c0; ch < c1; ++ch) {
+                        const bool edge = (p > 0 && ch < c0 + span) || (p + 1 < pieces && ch + span >= c1);
+                        const SlotSink<T> sink{in_ring.ring, in_ring.mask, edge ? slot_.data() : nullptr};
+                        pp += slots_of<true>(std::size_t(pstart[ch * kChunk]), std::size_t(pstart[std::min(n, (ch + 1) * kChunk)]), nullptr, sink);
+                        for (Index e = sum_start[ch]; e < sum_start[ch + 1]; ++e) {
+                            const std::size_t s = std::size_t(sum_order[e]);
+                            if (std::size_t(first_chunk[s]) < c0) later.push_back(Index(s));
+                            else sum_particle(s, nt, in_ring);
+                        }
+                    }
+                }
             }
 #pragma omp barrier
-            // Each particle's sum in the canonical order: as j (partners of lower id, ascending), as i
-            // (partners of higher id, ascending), its walls in wall order; then Newton.
-            // The three components of a sum go as lanes of one quad (lane by lane, the scalar additions;
-            // x - y is x + (-y)), each read as the quad that starts at it in the slot: f, t_i and t_j
-            // are three consecutive values, and the fourth lane, the next value along, is not used.
-            const T* base = reinterpret_cast<const T*>(slot);
-            auto quad_at = [base](std::size_t k, std::size_t offset) {
-                Quad<T> q;
-                std::memcpy(&q, base + 9 * k + offset, sizeof(q));
-                return q;
-            };
-            for (std::size_t s = lo; s < hi; ++s) {
-                Quad<T> f{}, tq{};
-                for (Index e = lstart[s]; e < lstart[s + 1]; ++e) {
-                    const std::size_t k = std::size_t(lslot[e]);
-                    f -= quad_at(k, 0);
-                    if constexpr (M::rotation) tq += quad_at(k, 6);
-                }
-                for (Index k = pstart[s]; k < pstart[s + 1]; ++k) {
-                    f += quad_at(std::size_t(k), 0);
-                    if constexpr (M::rotation) tq += quad_at(std::size_t(k), 3);
-                }
-                Vec3<T> F{f[0], f[1], f[2]}, Tq{tq[0], tq[1], tq[2]};
-                walls.add(s, F, Tq);
-                put(f_, s, F);
-                put(t_, s, Tq);
-            }
-            newton(lo, hi);
+            const SlotSink<T> in_list{slot_.data(), ~std::size_t(0), nullptr};
+            for (const Index s : later) sum_particle(std::size_t(s), nt, in_list);
         }
         pp_ = pp;
         pw_ = pw;
+    }
+
+    // piece_chunk_[p], p = 0 … pieces: where each piece of the sweep starts, in chunks, cut so that the
+    // pieces hold about as many slots each.
+    void cut_pieces(std::size_t pieces, std::size_t chunks)
+    {
+        piece_chunk_.resize(pieces + 1);
+        const std::size_t total = partner_.size();
+        std::size_t ch = 0;
+        piece_chunk_[0] = 0;
+        for (std::size_t p = 1; p < pieces; ++p) {
+            const std::size_t want = total * p / pieces;
+            while (ch < chunks && std::size_t(pstart_[ch * kChunk]) < want) ++ch;
+            piece_chunk_[p] = ch;
+        }
+        piece_chunk_[pieces] = chunks;
+    }
+
+    // Particle s's sum in the canonical order: as j (partners of lower id, ascending), as i (partners of
+    // higher id, ascending), its walls in wall order; then Newton's law. The slots from `from` (its ring
+    // and mask); nt: the thread count, whose ranges say whose wall candidates hold s's.
+    // The three components of a sum go as lanes of one quad (lane by lane, the scalar additions; x - y is
+    // x + (-y)), each read as the quad that starts at it in the slot: f, t_i and t_j are three consecutive
+    // values, and the fourth lane, the next value along, is not used.
+    void sum_particle(std::size_t s, std::size_t nt, const SlotSink<T>& from)
+    {
+        const T* base = reinterpret_cast<const T*>(from.ring);
+        const std::size_t mask = from.mask;
+        auto quad_at = [base, mask](std::size_t k, std::size_t offset) {
+            Quad<T> q;
+            std::memcpy(&q, base + 9 * (k & mask) + offset, sizeof(q));
+            return q;
+        };
+        const Index* lslot = lslot_.data();
+        Quad<T> f{}, tq{};
+        for (Index e = lstart_[s]; e < lstart_[s + 1]; ++e) {
+            const std::size_t k = std::size_t(lslot[e]);
+            f -= quad_at(k, 0);
+            if constexpr (M::rotation) tq += quad_at(k, 6);
+        }
+        for (Index k = pstart_[s]; k < pstart_[s + 1]; ++k) {
+            f += quad_at(std::size_t(k), 0);
+            if constexpr (M::rotation) tq += quad_at(std::size_t(k), 3);
+        }
+        if (near_wall_[s]) {
+            std::size_t u = 0;  // the thread whose range holds s
+            while (s >= n_ * (u + 1) / nt) ++u;
+            const std::vector<WallCandidate>& cand = wall_cand_[u];
+            const Load<T>* res = wall_res_[u].data();
+            for (std::size_t e = std::size_t(wall_first_[s]); e < cand.size() && std::size_t(cand[e].s) == s; ++e) {
+                f += res[e].f;
+                if constexpr (M::rotation) tq += res[e].t;
+            }
+        }
+        const std::size_t n = n_;
+        for (int c = 0; c < 3; ++c) {
+            f_[std::size_t(c) * n + s] = f[c];
+            acc_[std::size_t(c) * n + s] = acceleration(f[c], m_[s], component(g_, c));
+            t_[std::size_t(c) * n + s] = tq[c];
+            if constexpr (M::rotation) alc_[std::size_t(c) * n + s] = tq[c] / I_[s];
+        }
     }
 
     // This thread's share of the particles, [lo, hi) (inside a parallel region; all of them outside).
@@ -648,6 +737,7 @@ private:
         const std::uint8_t* near = near_wall_.data();
         for (std::size_t s = lo; s < hi; ++s) {
             if (!near[s]) continue;
+            wall_first_[s] = Index(cand.size());
             if (nw_ <= kWallBits) {  // the walls are the bits, ascending
                 for (unsigned m = near[s]; m != 0; m &= m - 1) cand.push_back({Index(s), Index(__builtin_ctz(m))});
                 continue;
@@ -854,11 +944,18 @@ private:
             throw InstabilityError(fmt::format("particle {} has a runaway position (found by the fast variant's cell search)", id_[far]), -1,
                                    std::int64_t(id_[far]));
         }
-        dims_[0] = dims[0];
-        dims_[1] = dims[1];
-        const std::int64_t* q = cell3_.data();
+        // The axes in the key by extent, the shortest fastest, so that the particles a pair can join (the
+        // 27 cells around) lie as close in storage as the box allows: in a flat bed, a slice across its
+        // longest axis, not a horizontal layer.
+        int ax[3] = {0, 1, 2};
+        std::sort(ax, ax + 3, [&](int a, int b) { return dims[a] < dims[b]; });
+        dims_[0] = dims[ax[0]];
+        dims_[1] = dims[ax[1]];
+        const std::int64_t* q0 = cell3_.data() + std::size_t(ax[0]) * n;
+        const std::int64_t* q1 = cell3_.data() + std::size_t(ax[1]) * n;
+        const std::int64_t* q2 = cell3_.data() + std::size_t(ax[2]) * n;
         for (std::size_t s = 0; s < n; ++s)
-            key_[s] = {std::uint64_t(q[s] + dims[0] * (q[n + s] + dims[1] * q[2 * n + s])), id_[s], Index(s)};
+            key_[s] = {std::uint64_t(q0[s] + dims_[0] * (q1[s] + dims_[1] * q2[s])), id_[s], Index(s)};
         // A compact box (the usual case) gets a table of cell starts and a stable counting sort, O(N);
         // a huge sparse box (the paper's literal 2 m box) a comparison sort and binary searches.
         dense_ = cells <= double(8 * n + 4096);
@@ -966,10 +1063,6 @@ private:
                 total = std::size_t(pstart[n]);
                 partner_.resize(total);
                 owner_.resize(total);
-                if (canonical) {
-                    slot_.resize(total + 1);  // + 1: the sums read a quad from the last slot's t_j
-                    touch_.assign(total, 1);  // "maybe in contact": the first pass zeroes the slots it drops
-                }
                 spans_.resize(std::size_t(thread_count()));
                 span_threads_ = std::size_t(thread_count());
             }
@@ -1005,6 +1098,33 @@ private:
 #pragma omp parallel for schedule(static) if (par_)
         for (std::size_t s = 0; s < n; ++s)
             std::sort(lslot + lstart[s], lslot + lstart[s + 1], [&](Index a, Index b) { return id_[owner[a]] < id_[owner[b]]; });
+        // The canonical sweep's schedule: a particle's sum waits for the chunk of the last owner of its
+        // slots (itself for its own, its partners of lower id for the others) and needs every chunk from
+        // that of the first; sum_order_ lists the particles by the chunk they wait for.
+        const std::size_t chunks = (n + kChunk - 1) / kChunk;
+        first_chunk_.resize(n);
+        sum_order_.resize(n);
+        span_chunks_ = 0;
+        std::size_t reach = 0;  // the most slots from a particle's first to the end of its last chunk
+        sum_start_.assign(chunks + 1, 0);
+        for (std::size_t s = 0; s < n; ++s) {
+            std::size_t first = s, last = s;
+            for (Index e = lstart[s]; e < lstart[s + 1]; ++e) {
+                const std::size_t o = std::size_t(owner[lslot[e]]);
+                first = std::min(first, o);
+                last = std::max(last, o);
+            }
+            first_chunk_[s] = Index(first / kChunk);
+            tmpi_[s] = Index(last / kChunk);
+            ++sum_start_[last / kChunk + 1];
+            span_chunks_ = std::max(span_chunks_, last / kChunk - first / kChunk);
+            reach = std::max(reach, std::size_t(pstart[std::min(n, (last / kChunk + 1) * kChunk)] - pstart[first / kChunk * kChunk]));
+        }
+        ring_slots_ = std::bit_ceil(std::max<std::size_t>(reach, 1));
+        for (std::size_t c = 0; c < chunks; ++c) sum_start_[c + 1] += sum_start_[c];
+        for (std::size_t s = 0; s < n; ++s) sum_order_[std::size_t(sum_start_[std::size_t(tmpi_[s])]++)] = Index(s);
+        for (std::size_t c = chunks; c > 0; --c) sum_start_[c] = sum_start_[c - 1];  // back to starts
+        sum_start_[0] = 0;
     }
 
     FastOptions opt_;
@@ -1025,10 +1145,20 @@ private:
     std::vector<WallRecord<T>> wall_rec_;                                    // (walls)
     // The neighbour list: pairs of s in [pstart[s], pstart[s+1]), one slot each; where s is the partner.
     std::vector<Index> pstart_, partner_, owner_, lstart_, lslot_;
-    std::vector<Slot<T>> slot_;
-    std::vector<std::uint8_t> touch_;         // each listed pair: in contact this step (then slot_ holds it; canonical)
+    std::vector<Slot<T>> slot_;  // every slot (canonical mode on several threads: the straddling sums' slots)
     std::vector<Kin<T>> kin_;                 // (N) the kernel's copy of x, R, v, ω
     std::vector<std::uint8_t> near_wall_;   // (N) the walls it may touch this step (a bit each, see mark_walls)
+    std::vector<Index> wall_first_;          // (N) where a particle marked near a wall has its first candidate
+    // The canonical sweep: per particle, the chunk of its slots' first owner; the particles by the chunk
+    // of their last (sum_order_, from sum_start_[chunk]); where each piece starts, in chunks; per thread,
+    // the sums left for after the sweep.
+    std::vector<Index> first_chunk_, sum_start_, sum_order_;
+    std::vector<std::size_t> piece_chunk_;
+    std::vector<std::vector<Index>> leftover_;
+    // The most chunks and slots from a particle's first slot to its last (the sweep's reach); per thread,
+    // a ring of ring_slots_ slots (a power of two, at least that reach), + 1 for the sums' last quad.
+    std::size_t span_chunks_ = 0, ring_slots_ = 1;
+    std::vector<std::vector<Slot<T>>> rings_;
     std::vector<std::vector<WallCandidate>> wall_cand_;  // per thread: the particle–wall pairs that may touch
     std::vector<std::vector<Load<T>>> wall_res_;         // per thread: their force and torque (zeros: no contact)
     std::vector<Key> key_, keytmp_;
