@@ -81,6 +81,15 @@ struct SlotSink {
     }
 };
 
+// Where a sum reads slot k: lo[k & mask] below `split`, hi[k & mask] from it on (a ring: mask + 1 slots,
+// plus one; the whole list: mask all ones).
+template <class T>
+struct SlotSource {
+    const Slot<T>* lo;
+    const Slot<T>* hi;
+    std::size_t mask, split;
+};
+
 // Four values loaded and stored as one vector (32 bytes for double): the unit of the kernel's transposes.
 template <class T>
 using Quad = Pack<T, 4>;
@@ -346,7 +355,7 @@ public:
                                 &r_, &m_, &I_, &tmp1_})
             b += arr->capacity() * sizeof(T);
         for (const auto* arr : {&id_, &pos_, &tmpi_, &pstart_, &partner_, &owner_, &lstart_, &lslot_, &cstart_, &wall_first_, &first_chunk_,
-                                &sum_start_, &sum_order_})
+                                &last_chunk_, &last_start_, &by_last_, &first_start_, &by_first_})
             b += arr->capacity() * sizeof(Index);
         b += slot_.capacity() * sizeof(Slot<T>) + near_wall_.capacity();
         for (const auto& r : rings_) b += r.capacity() * sizeof(Slot<T>);
@@ -356,9 +365,8 @@ public:
         for (const auto& l : wall_res_) b += l.capacity() * sizeof(Load<T>);
         for (const auto& l : wall_cand_) b += l.capacity() * sizeof(WallCandidate);
         for (const auto& v : scan_) b += v.capacity() * sizeof(Index);
-        for (const auto& v : leftover_) b += v.capacity() * sizeof(Index);
         b += piece_chunk_.capacity() * sizeof(std::size_t);
-        b += ncursors_ * sizeof(BlockCursor);
+        b += nclaims_ * sizeof(Claim);
         return b;
     }
 
@@ -387,11 +395,7 @@ private:
     static constexpr int kLanes = native_lanes<T>;
     static constexpr std::size_t kBlock = 1024;
     static constexpr std::size_t kWallBits = 8;  // near_wall_ holds a bit per wall up to this many walls
-    // The canonical sweep (forces_canonical) goes a chunk of kChunk particles at a time, in pieces of
-    // kPiecesPerThread per thread when there are several (settled bed of 10^5, 2 threads: 1, 2 and 4
-    // pieces per thread took the same time within the noise; more pieces, more sums that straddle two).
-    static constexpr std::size_t kChunk = 128;
-    static constexpr std::size_t kPiecesPerThread = 2;
+    static constexpr std::size_t kChunk = 128;  // particles per chunk of the canonical sweep (forces_canonical)
 
     // Slots [k0, k1) (owner s, partner q): the contacts among them, each into its slot (canonical mode,
     // through `sink`) or added to the loads `load` of both particles (unordered mode). A canonical sum
@@ -543,29 +547,31 @@ private:
         const std::size_t n = n_;
         std::int64_t pp = 0, pw = 0;
         const Index* pstart = pstart_.data();
-        const Index* sum_start = sum_start_.data();
-        const Index* sum_order = sum_order_.data();
+        const Index* by_last = by_last_.data();
+        const Index* last_start = last_start_.data();
+        const Index* by_first = by_first_.data();
+        const Index* first_start = first_start_.data();
         const Index* first_chunk = first_chunk_.data();
+        const Index* last_chunk = last_chunk_.data();
         const std::size_t chunks = (n + kChunk - 1) / kChunk, span = span_chunks_;
         const std::size_t limit = std::size_t(thread_limit());
         per_thread_walls();
-        per_thread_cursors();
-        if (leftover_.size() < limit) {
-            leftover_.resize(limit);
-            rings_.resize(limit);
-        }
+        per_thread_claims();
+        if (rings_.size() < limit) rings_.resize(limit);
 #pragma omp parallel reduction(+ : pp, pw) if (par_)
         {
             const auto [lo, hi] = thread_range(n);
             const std::size_t nt = std::size_t(thread_count()), t = std::size_t(thread_index());
-            const std::size_t pieces = nt == 1 ? 1 : kPiecesPerThread * nt;
+            // Two threads to a piece, one from each end; an odd thread count leaves the last piece one.
+            const std::size_t pieces = (nt + 1) / 2, p = t / 2;
+            const bool down = t % 2 == 1;
 #pragma omp single
             {
                 cut_pieces(pieces, chunks);
+                for (std::size_t q = 0; q < pieces; ++q)
+                    claims_[q].v.store(std::uint64_t(piece_chunk_[q + 1]) << 32 | std::uint64_t(piece_chunk_[q]), std::memory_order_relaxed);
                 if (pieces > 1) slot_.resize(partner_.size() + 1);  // + 1: a sum reads a quad from the last slot's t_j
             }
-            cursors_[t].next.store(pieces * t / nt, std::memory_order_relaxed);
-            cursors_[t].end = pieces * (t + 1) / nt;
             std::vector<Slot<T>>& ring = rings_[t];
             if (ring.size() < ring_slots_ + 1) ring.assign(ring_slots_ + 1, Slot<T>{});
             begin_forces(lo, hi, t);
@@ -574,37 +580,94 @@ private:
 #pragma omp barrier
             // The pair kernel and the canonical sums in one sweep over the storage order, so that each
             // particle's slots are summed from a ring that stays in cache, not from a list of them all
-            // (at 32000 grains, 10 MB written and read back every step). A piece of the storage is one
-            // thread's, chunk by chunk in order: the chunk's slots, then the sums of the particles whose
-            // last slot (as i or as j) was in it and whose first was in the piece. The others straddle two
-            // pieces: their slots, within span_chunks_ of a piece's ends, also go to slot_, where their
-            // sums read them after the sweep. Pieces are taken a piece at a time: this thread's own first,
-            // then those the others have not begun. Which thread sums a particle, and when, changes no bit.
-            std::vector<Index>& later = leftover_[t];
-            later.clear();
+            // (at 32000 grains, 10 MB written and read back every step). A piece of the storage is swept
+            // by two threads, chunk by chunk, one upwards from its start and one downwards from its end,
+            // until they meet (wherever the machine lets them: neither waits for the other). After each
+            // chunk, the upward thread sums the particles whose last slot (as i or as j) was in it, the
+            // downward one those whose first was, when all their slots are in its ring. The others straddle
+            // the meeting point or the end of a piece; they are summed after the sweep (straddlers). Which
+            // thread sums a particle, and when, changes no bit of its sum.
+            const std::size_t c0 = piece_chunk_[p], c1 = piece_chunk_[p + 1];
             const SlotSink<T> in_ring{ring.data(), ring_slots_ - 1, nullptr};
-            for (std::size_t k = 0; k < nt; ++k) {
-                BlockCursor& c = cursors_[(t + k) % nt];
-                for (std::size_t p; (p = c.next.fetch_add(1, std::memory_order_relaxed)) < c.end;) {
-                    const std::size_t c0 = piece_chunk_[p], c1 = piece_chunk_[p + 1];
-                    for (std::size_t ch = c0; ch < c1; ++ch) {
-                        const bool edge = (p > 0 && ch < c0 + span) || (p + 1 < pieces && ch + span >= c1);
-                        const SlotSink<T> sink{in_ring.ring, in_ring.mask, edge ? slot_.data() : nullptr};
-                        pp += slots_of<true>(std::size_t(pstart[ch * kChunk]), std::size_t(pstart[std::min(n, (ch + 1) * kChunk)]), nullptr, sink);
-                        for (Index e = sum_start[ch]; e < sum_start[ch + 1]; ++e) {
-                            const std::size_t s = std::size_t(sum_order[e]);
-                            if (std::size_t(first_chunk[s]) < c0) later.push_back(Index(s));
-                            else sum_particle(s, nt, in_ring);
-                        }
-                    }
+            for (std::size_t ch; down ? claim_down(claims_[p], ch) : claim_up(claims_[p], ch);) {
+                // Slots near the end of a piece are also kept in slot_, for the sums that straddle two pieces.
+                const bool edge = (p > 0 && ch < c0 + span) || (p + 1 < pieces && ch + span >= c1);
+                const SlotSink<T> sink{in_ring.ring, in_ring.mask, edge ? slot_.data() : nullptr};
+                pp += slots_of<true>(std::size_t(pstart[ch * kChunk]), std::size_t(pstart[std::min(n, (ch + 1) * kChunk)]), nullptr, sink);
+                const SlotSource<T> from{in_ring.ring, in_ring.ring, in_ring.mask, 0};
+                if (!down) {
+                    for (Index e = last_start[ch]; e < last_start[ch + 1]; ++e)
+                        if (const std::size_t s = std::size_t(by_last[e]); std::size_t(first_chunk[s]) >= c0) sum_particle(s, nt, from);
+                } else {
+                    for (Index e = first_start[ch]; e < first_start[ch + 1]; ++e)
+                        if (const std::size_t s = std::size_t(by_first[e]); std::size_t(last_chunk[s]) < c1) sum_particle(s, nt, from);
                 }
             }
 #pragma omp barrier
-            const SlotSink<T> in_list{slot_.data(), ~std::size_t(0), nullptr};
-            for (const Index s : later) sum_particle(std::size_t(s), nt, in_list);
+            if (!down) {
+                // The particles of this piece that straddle its meeting point m: their slots below m are in
+                // this thread's ring, those from m on in its partner's (each holds the last ring_slots_ it
+                // wrote, and no sum reaches over more).
+                const std::size_t m = std::size_t(claims_[p].v.load(std::memory_order_relaxed) & 0xffffffffu);
+                const std::vector<Slot<T>>& other = t + 1 < nt ? rings_[t + 1] : ring;
+                const SlotSource<T> split{ring.data(), other.data(), ring_slots_ - 1, std::size_t(pstart[std::min(n, m * kChunk)])};
+                for (std::size_t ch = m; ch < std::min(c1, m + span + 1); ++ch)
+                    for (Index e = last_start[ch]; e < last_start[ch + 1]; ++e) {
+                        const std::size_t s = std::size_t(by_last[e]), f = std::size_t(first_chunk[s]);
+                        if (f >= c0 && f < m) sum_particle(s, nt, split);
+                    }
+                // Those whose first slot is in the piece before (slot_ holds all the slots they read).
+                if (p > 0) {
+                    const SlotSource<T> all{slot_.data(), slot_.data(), ~std::size_t(0), 0};
+                    const std::size_t b0 = piece_chunk_[p - 1];
+                    for (std::size_t ch = c0; ch < std::min(chunks, c0 + span + 1); ++ch)
+                        for (Index e = last_start[ch]; e < last_start[ch + 1]; ++e) {
+                            const std::size_t s = std::size_t(by_last[e]), f = std::size_t(first_chunk[s]);
+                            if (f >= b0 && f < c0) sum_particle(s, nt, all);
+                        }
+                }
+            }
         }
         pp_ = pp;
         pw_ = pw;
+    }
+
+    // A piece's claims: the next chunk up (low 32 bits) and one past the next chunk down (high 32 bits);
+    // the sweep ends where they meet. One cache line each.
+    struct alignas(64) Claim {
+        std::atomic<std::uint64_t> v{0};
+    };
+    static bool claim_up(Claim& c, std::size_t& ch)
+    {
+        std::uint64_t v = c.v.load(std::memory_order_relaxed);
+        for (;;) {
+            const std::uint64_t up = v & 0xffffffffu, down = v >> 32;
+            if (up >= down) return false;
+            if (c.v.compare_exchange_weak(v, down << 32 | (up + 1), std::memory_order_relaxed)) {
+                ch = std::size_t(up);
+                return true;
+            }
+        }
+    }
+    static bool claim_down(Claim& c, std::size_t& ch)
+    {
+        std::uint64_t v = c.v.load(std::memory_order_relaxed);
+        for (;;) {
+            const std::uint64_t up = v & 0xffffffffu, down = v >> 32;
+            if (up >= down) return false;
+            if (c.v.compare_exchange_weak(v, (down - 1) << 32 | up, std::memory_order_relaxed)) {
+                ch = std::size_t(down - 1);
+                return true;
+            }
+        }
+    }
+    void per_thread_claims()
+    {
+        const std::size_t limit = std::size_t(thread_limit());
+        if (nclaims_ < limit) {
+            claims_ = std::make_unique<Claim[]>(limit);
+            nclaims_ = limit;
+        }
     }
 
     // piece_chunk_[p], p = 0 … pieces: where each piece of the sweep starts, in chunks, cut so that the
@@ -624,18 +687,19 @@ private:
     }
 
     // Particle s's sum in the canonical order: as j (partners of lower id, ascending), as i (partners of
-    // higher id, ascending), its walls in wall order; then Newton's law. The slots from `from` (its ring
-    // and mask); nt: the thread count, whose ranges say whose wall candidates hold s's.
+    // higher id, ascending), its walls in wall order; then Newton's law. The slots from `from`; nt: the
+    // thread count, whose ranges say whose wall candidates hold s's.
     // The three components of a sum go as lanes of one quad (lane by lane, the scalar additions; x - y is
     // x + (-y)), each read as the quad that starts at it in the slot: f, t_i and t_j are three consecutive
     // values, and the fourth lane, the next value along, is not used.
-    void sum_particle(std::size_t s, std::size_t nt, const SlotSink<T>& from)
+    void sum_particle(std::size_t s, std::size_t nt, const SlotSource<T>& from)
     {
-        const T* base = reinterpret_cast<const T*>(from.ring);
-        const std::size_t mask = from.mask;
-        auto quad_at = [base, mask](std::size_t k, std::size_t offset) {
+        const T* lo = reinterpret_cast<const T*>(from.lo);
+        const T* hi = reinterpret_cast<const T*>(from.hi);
+        const std::size_t mask = from.mask, split = from.split;
+        auto quad_at = [=](std::size_t k, std::size_t offset) {
             Quad<T> q;
-            std::memcpy(&q, base + 9 * (k & mask) + offset, sizeof(q));
+            std::memcpy(&q, (k < split ? lo : hi) + 9 * (k & mask) + offset, sizeof(q));
             return q;
         };
         const Index* lslot = lslot_.data();
@@ -699,22 +763,6 @@ private:
                 for (std::size_t s = c0; s < c1; ++s)
                     near[s] |= std::uint8_t(std::uint8_t(may_touch_wall(Vec3<T>{x[s], x[n + s], x[2 * n + s]}, r[s], p, nrm)) << bit);
             }
-        }
-    }
-
-    // A thread's share of the pair kernel's blocks, [next, end), taken a block at a time by it and, once
-    // they are done with their own, by the others (one cache line each, so that the counters do not share one).
-    struct alignas(64) BlockCursor {
-        std::atomic<std::size_t> next{0};
-        std::size_t end = 0;
-    };
-
-    void per_thread_cursors()
-    {
-        const std::size_t limit = std::size_t(thread_limit());
-        if (ncursors_ < limit) {
-            cursors_ = std::make_unique<BlockCursor[]>(limit);
-            ncursors_ = limit;
         }
     }
 
@@ -1098,15 +1146,14 @@ private:
 #pragma omp parallel for schedule(static) if (par_)
         for (std::size_t s = 0; s < n; ++s)
             std::sort(lslot + lstart[s], lslot + lstart[s + 1], [&](Index a, Index b) { return id_[owner[a]] < id_[owner[b]]; });
-        // The canonical sweep's schedule: a particle's sum waits for the chunk of the last owner of its
-        // slots (itself for its own, its partners of lower id for the others) and needs every chunk from
-        // that of the first; sum_order_ lists the particles by the chunk they wait for.
+        // The canonical sweep's schedule: a particle's sum needs the slots of the chunks from that of the
+        // first owner of its slots to that of the last (itself for its own, its partners of lower id for
+        // the others).
         const std::size_t chunks = (n + kChunk - 1) / kChunk;
         first_chunk_.resize(n);
-        sum_order_.resize(n);
+        last_chunk_.resize(n);
         span_chunks_ = 0;
-        std::size_t reach = 0;  // the most slots from a particle's first to the end of its last chunk
-        sum_start_.assign(chunks + 1, 0);
+        std::size_t reach = 0;  // the most slots from the start of a particle's first chunk to the end of its last
         for (std::size_t s = 0; s < n; ++s) {
             std::size_t first = s, last = s;
             for (Index e = lstart[s]; e < lstart[s + 1]; ++e) {
@@ -1114,17 +1161,29 @@ private:
                 first = std::min(first, o);
                 last = std::max(last, o);
             }
-            first_chunk_[s] = Index(first / kChunk);
-            tmpi_[s] = Index(last / kChunk);
-            ++sum_start_[last / kChunk + 1];
-            span_chunks_ = std::max(span_chunks_, last / kChunk - first / kChunk);
-            reach = std::max(reach, std::size_t(pstart[std::min(n, (last / kChunk + 1) * kChunk)] - pstart[first / kChunk * kChunk]));
+            first /= kChunk;
+            last /= kChunk;
+            first_chunk_[s] = Index(first);
+            last_chunk_[s] = Index(last);
+            span_chunks_ = std::max(span_chunks_, last - first);
+            reach = std::max(reach, std::size_t(pstart[std::min(n, (last + 1) * kChunk)] - pstart[first * kChunk]));
         }
         ring_slots_ = std::bit_ceil(std::max<std::size_t>(reach, 1));
-        for (std::size_t c = 0; c < chunks; ++c) sum_start_[c + 1] += sum_start_[c];
-        for (std::size_t s = 0; s < n; ++s) sum_order_[std::size_t(sum_start_[std::size_t(tmpi_[s])]++)] = Index(s);
-        for (std::size_t c = chunks; c > 0; --c) sum_start_[c] = sum_start_[c - 1];  // back to starts
-        sum_start_[0] = 0;
+        bucket_by_chunk(last_chunk_, chunks, last_start_, by_last_);
+        bucket_by_chunk(first_chunk_, chunks, first_start_, by_first_);
+    }
+
+    // The particles by chunk[s] (a stable counting sort): order[start[c] … start[c + 1]) holds those of chunk c.
+    void bucket_by_chunk(const std::vector<Index>& chunk, std::size_t chunks, std::vector<Index>& start, std::vector<Index>& order)
+    {
+        const std::size_t n = n_;
+        start.assign(chunks + 1, 0);
+        order.resize(n);
+        for (std::size_t s = 0; s < n; ++s) ++start[std::size_t(chunk[s]) + 1];
+        for (std::size_t c = 0; c < chunks; ++c) start[c + 1] += start[c];
+        for (std::size_t s = 0; s < n; ++s) order[std::size_t(start[std::size_t(chunk[s])]++)] = Index(s);
+        for (std::size_t c = chunks; c > 0; --c) start[c] = start[c - 1];  // back to starts
+        start[0] = 0;
     }
 
     FastOptions opt_;
@@ -1149,12 +1208,11 @@ private:
     std::vector<Kin<T>> kin_;                 // (N) the kernel's copy of x, R, v, ω
     std::vector<std::uint8_t> near_wall_;   // (N) the walls it may touch this step (a bit each, see mark_walls)
     std::vector<Index> wall_first_;          // (N) where a particle marked near a wall has its first candidate
-    // The canonical sweep: per particle, the chunk of its slots' first owner; the particles by the chunk
-    // of their last (sum_order_, from sum_start_[chunk]); where each piece starts, in chunks; per thread,
-    // the sums left for after the sweep.
-    std::vector<Index> first_chunk_, sum_start_, sum_order_;
+    // The canonical sweep: per particle, the chunks of its slots' first and last owners; the particles
+    // by their last chunk (by_last_, from last_start_[chunk]) and by their first; where each piece
+    // starts, in chunks.
+    std::vector<Index> first_chunk_, last_chunk_, last_start_, by_last_, first_start_, by_first_;
     std::vector<std::size_t> piece_chunk_;
-    std::vector<std::vector<Index>> leftover_;
     // The most chunks and slots from a particle's first slot to its last (the sweep's reach); per thread,
     // a ring of ring_slots_ slots (a power of two, at least that reach), + 1 for the sums' last quad.
     std::size_t span_chunks_ = 0, ring_slots_ = 1;
@@ -1170,8 +1228,8 @@ private:
     std::vector<std::pair<std::size_t, std::size_t>> spans_;  // per thread: the storage range its slots reach
     std::size_t span_threads_ = 0;                            // the thread count spans_ is for
     std::vector<std::vector<Index>> scan_;          // per thread: partners found by list_pairs' scan
-    std::unique_ptr<BlockCursor[]> cursors_;        // per thread: its share of the pair kernel's blocks (canonical mode)
-    std::size_t ncursors_ = 0;
+    std::unique_ptr<Claim[]> claims_;  // per piece of the canonical sweep
+    std::size_t nclaims_ = 0;
     std::int64_t pp_ = 0, pw_ = 0;
 };
 
