@@ -9,12 +9,15 @@
 #     kinetic energy and bed height while settling, the wall force while compressing; results/peers/physics_*.
 # Usage: scripts/run_peers.sh [--full] [--n "1000 2000"] [--steps K] [--repetitions R] [--variants LIST]
 #                             [--members M] [--physics-n N] [--bench-only] [--physics-only] [--prepare-only]
+#                             [--out DIR]
 #   --full  N = 1000 … 64000 (doubling), 500 steps, 5 repetitions, 8 ensemble members (the lead's run)
 #   --prepare-only  settle and export the stages of every N (the slow part, done once), then stop
+#   --out DIR  results and figures in DIR instead of results/peers and results/figures (a second,
+#              focused run beside the full one)
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ns="1000 2000 4000"; steps=200; reps=3; variants=all; members=4; phys_n=2000; warmup=20
-do_bench=1; do_phys=1; prepare_only=0
+do_bench=1; do_phys=1; prepare_only=0; out=results/peers; figures=results/figures
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --full) ns="1000 2000 4000 8000 16000 32000 64000"; steps=500; reps=5; members=8; shift ;;
@@ -27,7 +30,8 @@ while [[ $# -gt 0 ]]; do
     --bench-only) do_phys=0; shift ;;
     --physics-only) do_bench=0; shift ;;
     --prepare-only) prepare_only=1; shift ;;
-    *) echo "run_peers.sh: unknown option $1 (expected --full, --n, --steps, --repetitions, --variants, --members, --physics-n, --bench-only, --physics-only, --prepare-only)" >&2; exit 2 ;;
+    --out) out="$2"; figures="$2"; shift 2 ;;
+    *) echo "run_peers.sh: unknown option $1 (expected --full, --n, --steps, --repetitions, --variants, --members, --physics-n, --bench-only, --physics-only, --prepare-only, --out)" >&2; exit 2 ;;
   esac
 done
 
@@ -41,7 +45,6 @@ liggghts=$(command -v liggghts || true)
 [[ -n "$lmp" ]] || { echo "run_peers.sh: LAMMPS (lmp) is not installed; scripts/install_deps.sh --optional installs it" >&2; exit 1; }
 export OMP_NUM_THREADS=1   # one core for every code; no mpirun
 work=$PWD/$build/peers      # scenes, states, data files and raw outputs (large, not kept in the repository)
-out=results/peers
 mkdir -p "$work" "$out"
 
 # Versions of the peers, for the results' provenance.
@@ -122,7 +125,7 @@ if [[ $do_bench == 1 ]]; then
     echo "== benchmark repetition $((r + 1))/$reps done"
   done
   /usr/bin/python3 analysis/plot_peers.py bench --work "$work" --samples "$samples" --versions "$work/versions.json" \
-    --out "$out" --figure results/figures/peers_us_per_particle_step.png
+    --out "$out" --figure "$figures/peers_us_per_particle_step.png"
 fi
 
 if [[ $do_phys == 1 ]]; then
@@ -152,5 +155,5 @@ if [[ $do_phys == 1 ]]; then
     echo "== member $m/$members done"
   done
   /usr/bin/python3 analysis/plot_peers.py physics --work "$p" --versions "$work/versions.json" --particles "$n" \
-    --amplitude "$amplitude" --out "$out" --figure results/figures/peers_physics_${n}.png
+    --amplitude "$amplitude" --out "$out" --figure "$figures/peers_physics_${n}.png"
 fi

@@ -604,18 +604,22 @@ private:
                 }
             }
 #pragma omp barrier
-            if (!down) {
-                // The particles of this piece that straddle its meeting point m: their slots below m are in
-                // this thread's ring, those from m on in its partner's (each holds the last ring_slots_ it
-                // wrote, and no sum reaches over more).
+            {
+                // The particles of this piece that straddle its meeting point m (their last chunk is one of
+                // m … m + span, shared out between the piece's two threads): their slots below m are in the
+                // upward thread's ring, those from m on in the downward one's (each holds the last
+                // ring_slots_ it wrote, and no sum reaches over more). A piece of one thread met at its end.
                 const std::size_t m = std::size_t(claims_[p].v.load(std::memory_order_relaxed) & 0xffffffffu);
-                const std::vector<Slot<T>>& other = t + 1 < nt ? rings_[t + 1] : ring;
-                const SlotSource<T> split{ring.data(), other.data(), ring_slots_ - 1, std::size_t(pstart[std::min(n, m * kChunk)])};
-                for (std::size_t ch = m; ch < std::min(c1, m + span + 1); ++ch)
+                const std::size_t up = down ? t - 1 : t, other = !down && t + 1 == nt ? t : up + 1;
+                const SlotSource<T> split{rings_[up].data(), rings_[other].data(), ring_slots_ - 1, std::size_t(pstart[std::min(n, m * kChunk)])};
+                const std::size_t e1 = std::min(c1, m + span + 1), mid = m + (e1 - m) / 2;
+                for (std::size_t ch = down ? mid : m; ch < (down ? e1 : mid); ++ch)
                     for (Index e = last_start[ch]; e < last_start[ch + 1]; ++e) {
                         const std::size_t s = std::size_t(by_last[e]), f = std::size_t(first_chunk[s]);
                         if (f >= c0 && f < m) sum_particle(s, nt, split);
                     }
+            }
+            if (!down) {
                 // Those whose first slot is in the piece before (slot_ holds all the slots they read).
                 if (p > 0) {
                     const SlotSource<T> all{slot_.data(), slot_.data(), ~std::size_t(0), 0};
