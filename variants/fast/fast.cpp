@@ -401,10 +401,12 @@ private:
     // through `sink`) or added to the loads `load` of both particles (unordered mode). A canonical sum
     // reads every slot of a particle, so there a pair out of contact holds zeros, which add nothing (a sum
     // that starts at +0 is never -0, and x + ±0 = x for every other x), so the bits are those of arrays,
-    // which skips the pair; reading zeros costs less than a branch that is taken at random. may_touch first, a cheap and conservative test (the law rejects
-    // every pair it rejects), so the skin's extra candidates cost a distance, not a pass through the law;
-    // the rest go through the law kLanes at a time. The test sorts the slots into kept and dropped
-    // without a branch (a third are dropped, in no pattern a predictor learns). Returns the contacts found.
+    // which skips the pair; reading zeros costs less than a branch that is taken at random (a dropped
+    // pair's slot is zeroed every step: the ring's slot k & mask held another pair's). may_touch first, a
+    // cheap and conservative test (the law rejects every pair it rejects), so the skin's extra candidates
+    // cost a distance, not a pass through the law; the rest go through the law kLanes at a time. The test
+    // sorts the slots into kept and dropped without a branch (a third are dropped, in no pattern a
+    // predictor learns). Returns the contacts found.
     template <bool Canonical>
     std::int64_t slots_of(std::size_t k0, std::size_t k1, Load<T>* load, const SlotSink<T>& sink = {})
     {
