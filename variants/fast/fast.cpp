@@ -1138,17 +1138,11 @@ private:
             }
         }
         if (!canonical) return;
-        Index* partner = partner_.data();
         Index* owner = owner_.data();
         // The slots where each particle is the partner, by ascending id of the owner.
-        Index* lstart = lstart_.data();
-        std::fill(lstart_.begin(), lstart_.end(), 0);
-        for (std::size_t k = 0; k < total; ++k) ++lstart[std::size_t(partner[k]) + 1];
-        for (std::size_t s = 0; s < n; ++s) lstart[s + 1] += lstart[s];
-        lslot_.resize(total);
+        bucket_sort(partner_, n, lstart_, lslot_);
+        const Index* lstart = lstart_.data();
         Index* lslot = lslot_.data();
-        for (std::size_t s = 0; s < n; ++s) tmpi_[s] = lstart[s];
-        for (std::size_t k = 0; k < total; ++k) lslot[tmpi_[std::size_t(partner[k])]++] = Index(k);
 #pragma omp parallel for schedule(static) if (par_)
         for (std::size_t s = 0; s < n; ++s)
             std::sort(lslot + lstart[s], lslot + lstart[s + 1], [&](Index a, Index b) { return id_[owner[a]] < id_[owner[b]]; });
@@ -1175,20 +1169,21 @@ private:
             reach = std::max(reach, std::size_t(pstart[std::min(n, (last + 1) * kChunk)] - pstart[first * kChunk]));
         }
         ring_slots_ = std::bit_ceil(std::max<std::size_t>(reach, 1));
-        bucket_by_chunk(last_chunk_, chunks, last_start_, by_last_);
-        bucket_by_chunk(first_chunk_, chunks, first_start_, by_first_);
+        bucket_sort(last_chunk_, chunks, last_start_, by_last_);
+        bucket_sort(first_chunk_, chunks, first_start_, by_first_);
     }
 
-    // The particles by chunk[s] (a stable counting sort): order[start[c] … start[c + 1]) holds those of chunk c.
-    void bucket_by_chunk(const std::vector<Index>& chunk, std::size_t chunks, std::vector<Index>& start, std::vector<Index>& order)
+    // The indices i of key by key[i] (a stable counting sort into `buckets` buckets): order[start[b] …
+    // start[b + 1]) holds those of bucket b, ascending.
+    static void bucket_sort(const std::vector<Index>& key, std::size_t buckets, std::vector<Index>& start, std::vector<Index>& order)
     {
-        const std::size_t n = n_;
-        start.assign(chunks + 1, 0);
-        order.resize(n);
-        for (std::size_t s = 0; s < n; ++s) ++start[std::size_t(chunk[s]) + 1];
-        for (std::size_t c = 0; c < chunks; ++c) start[c + 1] += start[c];
-        for (std::size_t s = 0; s < n; ++s) order[std::size_t(start[std::size_t(chunk[s])]++)] = Index(s);
-        for (std::size_t c = chunks; c > 0; --c) start[c] = start[c - 1];  // back to starts
+        const std::size_t count = key.size();
+        start.assign(buckets + 1, 0);
+        order.resize(count);
+        for (std::size_t i = 0; i < count; ++i) ++start[std::size_t(key[i]) + 1];
+        for (std::size_t b = 0; b < buckets; ++b) start[b + 1] += start[b];
+        for (std::size_t i = 0; i < count; ++i) order[std::size_t(start[std::size_t(key[i])]++)] = Index(i);
+        for (std::size_t b = buckets; b > 0; --b) start[b] = start[b - 1];  // back to starts
         start[0] = 0;
     }
 
