@@ -804,8 +804,9 @@ private:
     }
 
     // The law on every thread's wall candidates, kLanes pairs at a time, the packs shared out among the
-    // threads whoever's particles they are (the floor's contacts all fall in the first thread's range of
-    // storage), into wall_res_ (zeros where h <= 0); no barrier at the end. Inside a parallel region,
+    // threads whoever's particles they are (a wall's grains may all fall in one thread's range of storage:
+    // the floor's did while the cell key put z slowest), into wall_res_ (zeros where h <= 0); no barrier
+    // at the end. Inside a parallel region,
     // after the candidates of every thread are listed. Returns the contacts found.
     std::int64_t wall_contacts()
     {
