@@ -217,7 +217,7 @@ public:
         cell_ = T(std::max(setup.cell_size, 2.0 * setup.radius_max)) + skin_;
         load_gear_columns<T>(s, {&x_, &v_, &a_, &b3_, &b4_, &b5_, &th_, &w_, &al_, &r3_, &r4_, &r5_});
         for (auto* arr : {&f_, &t_, &acc_, &alc_, &xref_, &tmp_}) arr->assign(3 * n_, T(0));
-        r_.resize(n_); m_.resize(n_); I_.resize(n_); id_.resize(n_); pos_.resize(n_); tmp1_.resize(n_); tmpi_.resize(n_);
+        r_.resize(n_); m_.resize(n_); I_.resize(n_); id_.resize(n_); pos_.resize(n_); tmp1_.resize(n_);
         for (std::size_t i = 0; i < n_; ++i) {
             r_[i] = T(s.radius[i]);
             m_[i] = T(setup.mass[i]);
@@ -354,7 +354,7 @@ public:
         for (const auto* arr : {&x_, &v_, &a_, &b3_, &b4_, &b5_, &th_, &w_, &al_, &r3_, &r4_, &r5_, &f_, &t_, &acc_, &alc_, &xref_, &tmp_,
                                 &r_, &m_, &I_, &tmp1_})
             b += arr->capacity() * sizeof(T);
-        for (const auto* arr : {&id_, &pos_, &tmpi_, &pstart_, &partner_, &owner_, &lstart_, &lslot_, &cstart_, &wall_first_, &first_chunk_,
+        for (const auto* arr : {&id_, &pos_, &pstart_, &partner_, &owner_, &lstart_, &lslot_, &cstart_, &wall_first_, &first_chunk_,
                                 &last_chunk_, &last_start_, &by_last_, &first_start_, &by_first_})
             b += arr->capacity() * sizeof(Index);
         b += slot_.capacity() * sizeof(Slot<T>) + near_wall_.capacity();
@@ -1202,7 +1202,7 @@ private:
     std::vector<T> x_, v_, a_, b3_, b4_, b5_, th_, w_, al_, r3_, r4_, r5_;  // (3N): x block, y block, z block
     std::vector<T> f_, t_, acc_, alc_, xref_, tmp_;                          // (3N)
     std::vector<T> r_, m_, I_, tmp1_;                                        // (N)
-    std::vector<Index> id_, pos_, tmpi_;                                     // (N)
+    std::vector<Index> id_, pos_;                                            // (N)
     std::vector<WallRecord<T>> wall_rec_;                                    // (walls)
     // The neighbour list: pairs of s in [pstart[s], pstart[s+1]), one slot each; where s is the partner.
     std::vector<Index> pstart_, partner_, owner_, lstart_, lslot_;
