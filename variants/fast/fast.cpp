@@ -12,9 +12,9 @@
 //   pair kernel writes each contact's force and torques into its slot; each particle then gathers, in
 //   the canonical order of physics.md §6, the slots where it is j (partners of lower id, ascending; a
 //   list kept across steps), then its own slots (partners of higher id, ascending, contiguous), then its
-//   walls, and applies Newton's law. Kernel and sums go in one sweep over the storage order, a chunk of
-//   particles at a time, and the sums read the slots from a small ring that stays in cache (see
-//   forces_canonical). No sum depends on which thread did what, so the bits do not depend on the
+//   walls; Newton's law follows in a vectorised pass. Kernel and sums go in one sweep over the storage
+//   order, a chunk of particles at a time, and the sums read the slots from a small ring that stays in
+//   cache (see forces_canonical). No sum depends on which thread did what, so the bits do not depend on the
 //   thread count.
 // - The kernel reads each particle's position, radius, velocity and angular velocity from one record
 //   (Kin, refreshed at the start of the force pass) and moves a pack's worth between records and lanes
@@ -633,6 +633,8 @@ private:
                         }
                 }
             }
+#pragma omp barrier  // every sum done, the straddlers' too
+            newton(lo, hi);
         }
         pp_ = pp;
         pw_ = pw;
@@ -693,8 +695,10 @@ private:
     }
 
     // Particle s's sum in the canonical order: as j (partners of lower id, ascending), as i (partners of
-    // higher id, ascending), its walls in wall order; then Newton's law. The slots from `from`; nt: the
-    // thread count, whose ranges say whose wall candidates hold s's.
+    // higher id, ascending), its walls in wall order, into f_ and t_ (Newton's law follows in a pass of
+    // its own: done here, a grain at a time, its six scalar divisions made the force pass 5 % longer,
+    // measured at 16000 grains on one thread and at 10⁵ on two). The slots from `from`; nt: the thread
+    // count, whose ranges say whose wall candidates hold s's.
     // The three components of a sum go as lanes of one quad (lane by lane, the scalar additions; x - y is
     // x + (-y)), each read as the quad that starts at it in the slot: f, t_i and t_j are three consecutive
     // values, and the fourth lane, the next value along, is not used.
@@ -732,9 +736,7 @@ private:
         const std::size_t n = n_;
         for (int c = 0; c < 3; ++c) {
             f_[std::size_t(c) * n + s] = f[c];
-            acc_[std::size_t(c) * n + s] = acceleration(f[c], m_[s], component(g_, c));
             t_[std::size_t(c) * n + s] = tq[c];
-            if constexpr (M::rotation) alc_[std::size_t(c) * n + s] = tq[c] / I_[s];
         }
     }
 
