@@ -22,6 +22,10 @@ struct FastOptions {
     // join per phase costs more than the work it shares (docs/variants.md, "fast"). The tests set 0, so
     // that their small scenes run on the threads they ask for.
     std::size_t min_parallel = 3000;
+    // From this many particles on the pair kernel prefetches its partners' records (docs/variants.md,
+    // "fast"; a hint to the caches, which changes no result). The tests set 0, so that their small
+    // scenes take that path too.
+    std::size_t prefetch_from = 8000;
 };
 
 class FastVariant : public Variant {
