@@ -68,12 +68,13 @@ LockstepResult lockstep(const Setup& setup, std::int64_t steps, const std::vecto
     return out;
 }
 
-// fast_unordered's options, on the threads asked for however small the scene.
+// fast_unordered's options, on the threads asked for and on the prefetching path however small the scene.
 FastOptions threaded_unordered()
 {
     FastOptions o;
     o.canonical = false;
     o.min_parallel = 0;
+    o.prefetch_from = 0;
     return o;
 }
 
