@@ -1277,6 +1277,10 @@ private:
             reach = std::max(reach, std::size_t(pstart[std::min(n, (last + 1) * kChunk)] - pstart[first * kChunk]));
         }
         ring_slots_ = std::bit_ceil(std::max<std::size_t>(reach, 1));
+        // The sums' tables hold byte offsets into a ring as 32-bit words.
+        if ((ring_slots_ + 2) * sizeof(Slot<T>) > std::size_t(UINT32_MAX))
+            throw CapacityError(fmt::format("the fast variant's canonical sweep needs a ring of {} slots, more than its 32-bit offsets "
+                                            "reach (a particle's partners are {} slots apart in storage)", ring_slots_, reach));
         bucket_sort(last_chunk_, chunks, last_start_, by_last_);
         bucket_sort(first_chunk_, chunks, first_start_, by_first_);
         group_table_.clear();
@@ -1379,7 +1383,8 @@ private:
     std::vector<Index> group_last_start_, group_first_start_, bucket_;
     std::vector<std::uint32_t> group_table_;
     // The most chunks and slots from a particle's first slot to its last (the sweep's reach); per thread,
-    // a ring of ring_slots_ slots (a power of two, at least that reach), + 1 for the sums' last quad.
+    // a ring of ring_slots_ slots (a power of two, at least that reach), + 2: a slot of zeros (the sums'
+    // padding) and room for the quad a sum reads from the last value of a slot.
     std::size_t span_chunks_ = 0, ring_slots_ = 1;
     std::vector<std::vector<Slot<T>>> rings_;
     std::vector<std::vector<WallCandidate>> wall_cand_;  // per thread: the particle–wall pairs that may touch
