@@ -799,7 +799,8 @@ private:
     // at 4000). The group's table (build_groups) holds the ring offsets in the canonical order, as j then
     // as i, a row of kGroup a step; a particle's list that ends before the group's longest goes on with
     // the ring's slot of zeros, which adds nothing (the sum starts at +0 and is never -0, and x + ±0 = x
-    // for every other x), so each particle's bits are those of sum_particle.
+    // for every other x), so each particle's bits are those of sum_particle (the same order, kept there for
+    // the sums that read two rings or the list of all slots, which the tables' ring offsets cannot name).
     void sum_group(const SumGroup& g, const Slot<T>* ring)
     {
         const char* base = reinterpret_cast<const char*>(ring);
@@ -913,8 +914,8 @@ private:
     // The law on every thread's wall candidates, kLanes pairs at a time, the packs shared out among the
     // threads whoever's particles they are (a wall's grains may all fall in one thread's range of storage:
     // the floor's did while the cell key put z slowest), into wall_res_ (zeros where h <= 0); no barrier
-    // at the end. Inside a parallel region,
-    // after the candidates of every thread are listed. Returns the contacts found.
+    // at the end. Inside a parallel region, after the candidates of every thread are listed. Returns the
+    // contacts found.
     std::int64_t wall_contacts()
     {
         const std::size_t nt = std::size_t(thread_count());
