@@ -218,7 +218,7 @@ public:
         // changes the candidates, never the contact set).
         cell_ = T(std::max(setup.cell_size, 2.0 * setup.radius_max)) + skin_;
         load_gear_columns<T>(s, {&x_, &v_, &a_, &b3_, &b4_, &b5_, &th_, &w_, &al_, &r3_, &r4_, &r5_});
-        for (auto* arr : {&f_, &t_, &acc_, &alc_, &xref_, &tmp_}) arr->assign(3 * n_, T(0));
+        for (auto* arr : {&f_, &t_, &xref_, &tmp_}) arr->assign(3 * n_, T(0));
         r_.resize(n_); m_.resize(n_); I_.resize(n_); id_.resize(n_); pos_.resize(n_); tmp1_.resize(n_);
         for (std::size_t i = 0; i < n_; ++i) {
             r_[i] = T(s.radius[i]);
@@ -243,67 +243,50 @@ public:
         rebuild();
     }
 
-    // The corrector of step n runs fused into the predictor of step n + 1: one pass that reads the Gear
-    // arrays once and writes them once, where a corrector pass and a predictor pass each read and wrote
-    // them all (1.15 kB per particle-step, 0.62 kB fused). Between the two the arrays hold the predicted
-    // state and acc_/alc_ the accelerations of step n (corrector_pending_); snapshot() and save() apply
-    // the corrector to what they read, with the same gear_correct, so they see the corrected state's bits.
-    // The driver times the fused pass as the predictor and finds correct() empty (docs/variants.md).
+    // One pass over the particles between two force passes, timed as the predictor (docs/variants.md,
+    // "fast"): everything that streams the per-particle arrays, done a block at a time while the block
+    // is in cache, instead of a pass each.
+    // - The corrector of step n fused into the predictor of step n + 1: the Gear arrays read once and
+    //   written once (624 B per particle-step; a corrector pass and a predictor pass moved 1152). Between
+    //   the two the arrays hold the predicted state and f_/t_ the forces of step n (corrector_pending_);
+    //   the corrector's accelerations come from them here, by the same acceleration() as arrays' Newton,
+    //   and snapshot() and save() apply the corrector to what they read, so they see the corrected bits.
+    // - The displacement check for the neighbour list (search() only reads its answer), the kernel's
+    //   records and the particles' wall bits and wall candidates, from the predicted positions.
+    // The driver finds correct() empty and search() a rebuild or nothing.
     void predict(std::int64_t step) override
     {
         step_ = step;
-        const std::size_t n3 = 3 * n_;
-        const GearCoefficients<T> k = gear_;
-        T* __restrict x = x_.data(); T* __restrict v = v_.data(); T* __restrict a = a_.data();
-        T* __restrict b3 = b3_.data(); T* __restrict b4 = b4_.data(); T* __restrict b5 = b5_.data();
-        T* __restrict th = th_.data(); T* __restrict w = w_.data(); T* __restrict al = al_.data();
-        T* __restrict r3 = r3_.data(); T* __restrict r4 = r4_.data(); T* __restrict r5 = r5_.data();
-        const T* __restrict acc = acc_.data();
-        const T* __restrict alc = alc_.data();
+        place_walls(step);
         const bool fused = corrector_pending_;
         corrector_pending_ = false;
-#pragma omp parallel if (par_)
-        {
-            if (fused) {
-#pragma omp for simd schedule(static) nowait
-                for (std::size_t e = 0; e < n3; ++e) correct_predict(x[e], v[e], a[e], b3[e], b4[e], b5[e], acc[e], k);
-                if constexpr (M::rotation) {
-#pragma omp for simd schedule(static) nowait
-                    for (std::size_t e = 0; e < n3; ++e) correct_predict(th[e], w[e], al[e], r3[e], r4[e], r5[e], alc[e], k);
-                }
-            } else {
-#pragma omp for simd schedule(static) nowait
-                for (std::size_t e = 0; e < n3; ++e) gear_predict(x[e], v[e], a[e], b3[e], b4[e], b5[e], k);
-                if constexpr (M::rotation) {
-#pragma omp for simd schedule(static) nowait
-                    for (std::size_t e = 0; e < n3; ++e) gear_predict(th[e], w[e], al[e], r3[e], r4[e], r5[e], k);
-                }
-            }
-        }
-        place_walls(step);
-    }
-
-    void search() override
-    {
+        per_thread_walls();
         // Rebuild when a pair may have closed by more than the skin since the last rebuild:
         // |Δx_i| + |Δx_j| ≤ 2·max|Δx|. 0.9 leaves room for rounding; a NaN fails the test and goes to
         // the rebuild, whose cell search reports it. (Walls need no list: see mark_walls.)
         const T half = T(0.9) * skin_ * T(0.5);
-        bool need = !(half > T(0));
-        if (!need) {
-            const T lim2 = half * half;
-            const std::size_t n = n_;
-            const T* __restrict x = x_.data();
-            const T* __restrict xr = xref_.data();
-            int over = 0;
-#pragma omp parallel for simd schedule(static) reduction(| : over) if (par_)
-            for (std::size_t s = 0; s < n; ++s) {
-                const T dx = x[s] - xr[s], dy = x[n + s] - xr[n + s], dz = x[2 * n + s] - xr[2 * n + s];
-                over |= int(!(dx * dx + dy * dy + dz * dz <= lim2));
+        int over = !(half > T(0));
+#pragma omp parallel reduction(| : over) if (par_)
+        {
+            const auto [lo, hi] = thread_range(n_);
+            const std::size_t t = std::size_t(thread_index());
+            wall_cand_[t].clear();
+            for (std::size_t b0 = lo; b0 < hi; b0 += kPassBlock) {
+                const std::size_t b1 = std::min(hi, b0 + kPassBlock);
+                integrate(b0, b1, fused);
+                over |= moved_too_far(b0, b1, half * half);
+                refresh_kin(b0, b1);
+                mark_walls(b0, b1);
+                list_walls(b0, b1, t);
             }
-            need = over != 0;
+            wall_res_[t].resize(wall_cand_[t].size());
         }
-        if (need) rebuild();
+        rebuild_due_ = over != 0;
+    }
+
+    void search() override
+    {
+        if (rebuild_due_) rebuild();
     }
 
     void forces() override
@@ -312,7 +295,8 @@ public:
         else forces_unordered();
     }
 
-    // Deferred to the next predict() (above), or applied by snapshot() and save() to what they read.
+    // Deferred to the next predict() (fused with its predictor), or applied by snapshot() and save() to
+    // what they read.
     void correct() override { corrector_pending_ = true; }
 
     void snapshot(Snapshot& out) const override
@@ -351,7 +335,7 @@ public:
     std::size_t memory_bytes() const override
     {
         std::size_t b = 0;
-        for (const auto* arr : {&x_, &v_, &a_, &b3_, &b4_, &b5_, &th_, &w_, &al_, &r3_, &r4_, &r5_, &f_, &t_, &acc_, &alc_, &xref_, &tmp_,
+        for (const auto* arr : {&x_, &v_, &a_, &b3_, &b4_, &b5_, &th_, &w_, &al_, &r3_, &r4_, &r5_, &f_, &t_, &xref_, &tmp_,
                                 &r_, &m_, &I_, &tmp1_})
             b += arr->capacity() * sizeof(T);
         for (const auto* arr : {&id_, &pos_, &pstart_, &partner_, &owner_, &lstart_, &lslot_, &cstart_, &wall_first_, &first_chunk_,
@@ -380,7 +364,7 @@ private:
         a[n_ + s] = v.y;
         a[2 * n_ + s] = v.z;
     }
-    // The corrector and then the predictor on one component of one degree of freedom (predict()).
+    // The corrector and then the predictor on one component of one degree of freedom (integrate()).
     [[gnu::always_inline]] static void correct_predict(T& x, T& v, T& a, T& b3, T& b4, T& b5, T accel, const GearCoefficients<T>& k)
     {
         T x1 = x, v1 = v, a1 = a, b31 = b3, b41 = b4, b51 = b5;
@@ -390,9 +374,61 @@ private:
         x = x1; v = v1; a = a1; b3 = b31; b4 = b41; b5 = b51;
     }
 
+    // The Gear step of particles [b0, b1): the pending corrector (accelerations from the last force
+    // pass, a = F/m + g and α = T/I, as Newton's law in arrays) fused with the predictor, or the
+    // predictor alone after init. A component block at a time: seven streams in, six out, vectorised.
+    void integrate(std::size_t b0, std::size_t b1, bool fused)
+    {
+        const std::size_t n = n_;
+        const GearCoefficients<T> k = gear_;
+        const T* __restrict m = m_.data();
+        const T* __restrict inertia = I_.data();
+        for (int c = 0; c < 3; ++c) {
+            const std::size_t o = std::size_t(c) * n;
+            T* __restrict x = x_.data() + o; T* __restrict v = v_.data() + o; T* __restrict a = a_.data() + o;
+            T* __restrict b3 = b3_.data() + o; T* __restrict b4 = b4_.data() + o; T* __restrict b5 = b5_.data() + o;
+            T* __restrict th = th_.data() + o; T* __restrict w = w_.data() + o; T* __restrict al = al_.data() + o;
+            T* __restrict r3 = r3_.data() + o; T* __restrict r4 = r4_.data() + o; T* __restrict r5 = r5_.data() + o;
+            const T* __restrict f = f_.data() + o;
+            const T* __restrict tq = t_.data() + o;
+            const T g = component(g_, c);
+            if (fused) {
+#pragma omp simd
+                for (std::size_t s = b0; s < b1; ++s) correct_predict(x[s], v[s], a[s], b3[s], b4[s], b5[s], acceleration(f[s], m[s], g), k);
+                if constexpr (M::rotation) {
+#pragma omp simd
+                    for (std::size_t s = b0; s < b1; ++s) correct_predict(th[s], w[s], al[s], r3[s], r4[s], r5[s], tq[s] / inertia[s], k);
+                }
+            } else {
+#pragma omp simd
+                for (std::size_t s = b0; s < b1; ++s) gear_predict(x[s], v[s], a[s], b3[s], b4[s], b5[s], k);
+                if constexpr (M::rotation) {
+#pragma omp simd
+                    for (std::size_t s = b0; s < b1; ++s) gear_predict(th[s], w[s], al[s], r3[s], r4[s], r5[s], k);
+                }
+            }
+        }
+    }
+
+    // Has a particle of [b0, b1) moved farther than sqrt(lim2) since the last rebuild (or is its
+    // position not finite)? 1 if so.
+    int moved_too_far(std::size_t b0, std::size_t b1, T lim2) const
+    {
+        const std::size_t n = n_;
+        const T* __restrict x = x_.data();
+        const T* __restrict xr = xref_.data();
+        int over = 0;
+#pragma omp simd reduction(| : over)
+        for (std::size_t s = b0; s < b1; ++s) {
+            const T dx = x[s] - xr[s], dy = x[n + s] - xr[n + s], dz = x[2 * n + s] - xr[2 * n + s];
+            over |= int(!(dx * dx + dy * dy + dz * dz <= lim2));
+        }
+        return over;
+    }
+
     // Particle s's six Gear values (x, v, a, b3, b4, b5) for translation or rotation, as the step's
     // corrector leaves them: the arrays' own while no corrector is pending, else the corrector applied to
-    // them here, by the same gear_correct the fused pass runs (predict()).
+    // them here, by the same acceleration() and gear_correct as the fused pass (integrate()).
     std::array<Vec3<T>, 6> gear_state(bool rotation, std::size_t s) const
     {
         const std::vector<T>* src[6] = {&x_, &v_, &a_, &b3_, &b4_, &b5_};
@@ -406,7 +442,7 @@ private:
             T q[6];
             for (int k = 0; k < 6; ++k) q[k] = (*src[k])[e];
             if (corrector_pending_ && (M::rotation || !rotation)) {
-                const T da = (rotation ? alc_ : acc_)[e] - q[2];
+                const T da = (rotation ? t_[e] / I_[s] : acceleration(f_[e], m_[s], component(g_, c))) - q[2];
                 gear_correct(q[0], q[1], q[2], q[3], q[4], q[5], da, gear_);
             }
             for (int k = 0; k < 6; ++k) component(g[std::size_t(k)], c) = q[k];
@@ -440,6 +476,10 @@ private:
     // fast_unordered's loads besides: -3 % at 16000, -19 % at 32000, -17 % at 64000, -20 % at 10⁵ on two.
     static constexpr std::size_t kPrefetch = 128;
     static constexpr int kGroup = 4;            // particles per sum group (sum_group)
+    // Particles per block of predict()'s pass, whose arrays stay in cache from one step of the pass to the
+    // next (settled bed of 10⁵, interleaved in one process, 16 repetitions: 256, 1024 and 4096 within 1 %
+    // on one thread; on two, 1024 took 8 % less than 256 and 3 % less than 4096).
+    static constexpr std::size_t kPassBlock = 1024;
 
     // A group of the canonical sums (sum_group): its particles (-1: none), the longest of their lists as
     // j and as i, and where its table starts in group_table_.
@@ -645,7 +685,6 @@ private:
         if (rings_.size() < limit) rings_.resize(limit);
 #pragma omp parallel reduction(+ : pp, pw) if (par_)
         {
-            const auto [lo, hi] = thread_range(n);
             const std::size_t nt = std::size_t(thread_count()), t = std::size_t(thread_index());
             // Two threads to a piece, one from each end; an odd thread count leaves the last piece one.
             const std::size_t pieces = (nt + 1) / 2, p = t / 2;
@@ -664,8 +703,7 @@ private:
             // the last value of a slot (its fourth lane, unused), past the end.
             if (ring.size() < ring_slots_ + 2) ring.assign(ring_slots_ + 2, Slot<T>{});
             ring[ring_slots_] = ring[ring_slots_ + 1] = Slot<T>{};  // a larger ring from before may hold slots there
-            begin_forces(lo, hi, t);
-#pragma omp barrier
+            // The kernel's records and every thread's wall candidates are ready (predict(), or a rebuild).
             pw += wall_contacts();
 #pragma omp barrier
             // The pair kernel and the canonical sums in one sweep over the storage order, so that each
@@ -732,8 +770,6 @@ private:
                         }
                 }
             }
-#pragma omp barrier  // every sum done, the straddlers' too
-            newton(lo, hi);
         }
         pp_ = pp;
         pw_ = pw;
@@ -922,13 +958,11 @@ private:
         }
     }
 
-    // The particle–wall pairs of [lo, hi), thread t's particles, that may touch (by particle, then wall
-    // order), into wall_cand_[t], with room for their results in wall_res_[t].
-    void wall_candidates(std::size_t lo, std::size_t hi, std::size_t t)
+    // Appends the particle–wall pairs of [lo, hi), in thread t's range, that may touch (by particle, then
+    // wall order; from the bits of mark_walls) to wall_cand_[t].
+    void list_walls(std::size_t lo, std::size_t hi, std::size_t t)
     {
-        mark_walls(lo, hi);
         std::vector<WallCandidate>& cand = wall_cand_[t];
-        cand.clear();
         const std::uint8_t* near = near_wall_.data();
         for (std::size_t s = lo; s < hi; ++s) {
             if (!near[s]) continue;
@@ -941,7 +975,6 @@ private:
             for (std::size_t w = 0; w < nw_; ++w)
                 if (may_touch_wall(Vec3<T>{xr[0], xr[1], xr[2]}, xr[3], wall_point(w), wall_normal(w))) cand.push_back({Index(s), Index(w)});
         }
-        wall_res_[t].resize(cand.size());
     }
 
     // The law on every thread's wall candidates, kLanes pairs at a time, the packs shared out among the
@@ -1022,40 +1055,10 @@ private:
         }
     };
 
-    // The start of a force pass for thread t's particles [lo, hi): their kernel records, and their wall
-    // candidates, whose results (wall_contacts, after a barrier) the sums add through the cursor.
-    WallCursor begin_forces(std::size_t lo, std::size_t hi, std::size_t t)
-    {
-        refresh_kin(lo, hi);
-        wall_candidates(lo, hi, t);
-        return {wall_cand_[t].data(), wall_res_[t].data(), wall_cand_[t].size()};
-    }
+    // Thread t's wall candidates (listed by predict() or a rebuild) and their results, which
+    // wall_contacts computes and the unordered sums add through this cursor.
+    WallCursor wall_cursor(std::size_t t) { return {wall_cand_[t].data(), wall_res_[t].data(), wall_cand_[t].size()}; }
 
-    // Newton's law for [lo, hi) from the loads in f_ and t_: a = F/m + g, α = T/I. A pass of its own,
-    // so that the divisions go a pack at a time.
-    void newton(std::size_t lo, std::size_t hi)
-    {
-        const std::size_t n = n_;
-        const T* __restrict m = m_.data();
-        const T* __restrict inertia = I_.data();
-        for (int c = 0; c < 3; ++c) {
-            const T* __restrict f = f_.data() + std::size_t(c) * n;
-            T* __restrict acc = acc_.data() + std::size_t(c) * n;
-            const T g = component(g_, c);
-#pragma omp simd
-            for (std::size_t s = lo; s < hi; ++s) acc[s] = acceleration(f[s], m[s], g);
-            if constexpr (M::rotation) {
-                const T* __restrict t = t_.data() + std::size_t(c) * n;
-                T* __restrict alc = alc_.data() + std::size_t(c) * n;
-#pragma omp simd
-                for (std::size_t s = lo; s < hi; ++s) alc[s] = t[s] / inertia[s];
-            }
-        }
-    }
-
-    // Unordered: each pair's force added to both particles as the pack computes it, into loads of the
-    // thread's own (zeroed over the span of particles its slots reach, set at the rebuild), then each
-    // particle's loads summed over the threads whose span holds it, in thread order, and its walls.
     void forces_unordered()
     {
         const std::size_t n = n_;
@@ -1073,8 +1076,7 @@ private:
             if (mine.size() != n) mine.resize(n);
             const auto [z0, z1] = spans_known ? spans_[t] : std::pair<std::size_t, std::size_t>{0, n};
             std::fill(mine.begin() + std::ptrdiff_t(z0), mine.begin() + std::ptrdiff_t(z1), Load<T>{});
-            WallCursor walls = begin_forces(lo, hi, t);
-#pragma omp barrier
+            WallCursor walls = wall_cursor(t);  // listed by predict() or a rebuild, like the kernel's records
             pw += wall_contacts();
             pp += slots_of<false>(std::size_t(pstart_[lo]), std::size_t(pstart_[hi]), mine.data());
 #pragma omp barrier
@@ -1091,7 +1093,6 @@ private:
                 put(f_, s, F);
                 put(t_, s, Tq);
             }
-            newton(lo, hi);
         }
         pp_ = pp;
         pw_ = pw;
@@ -1171,6 +1172,19 @@ private:
         permute();
         list_pairs();
         xref_ = x_;
+        // The new storage order's kernel records, wall bits and wall candidates (predict() made them for
+        // the old one).
+        per_thread_walls();
+#pragma omp parallel if (par_)
+        {
+            const auto [lo, hi] = thread_range(n);
+            const std::size_t t = std::size_t(thread_index());
+            refresh_kin(lo, hi);
+            mark_walls(lo, hi);
+            wall_cand_[t].clear();
+            list_walls(lo, hi, t);
+            wall_res_[t].resize(wall_cand_[t].size());
+        }
     }
 
     struct Key {
@@ -1386,7 +1400,8 @@ private:
 
     FastOptions opt_;
     bool par_ = true, prefetch_ = false;
-    bool corrector_pending_ = false;  // the arrays hold the predicted state of step_, acc_/alc_ its accelerations (predict())
+    bool corrector_pending_ = false;  // the arrays hold the predicted state of step_, f_/t_ its forces (predict())
+    bool rebuild_due_ = false;        // the displacement check of the last predict() asks for a rebuild
     std::size_t n_ = 0, nw_ = 0;
     std::int64_t step_ = 0, rebuilds_ = 0;
     double dt_ = 0.0;
@@ -1397,7 +1412,7 @@ private:
     std::vector<Wall> walls_;
     // Particles in storage (cell) order; id_[s] is the id at slot s, pos_[id] the slot of an id.
     std::vector<T> x_, v_, a_, b3_, b4_, b5_, th_, w_, al_, r3_, r4_, r5_;  // (3N): x block, y block, z block
-    std::vector<T> f_, t_, acc_, alc_, xref_, tmp_;                          // (3N)
+    std::vector<T> f_, t_, xref_, tmp_;                                      // (3N)
     std::vector<T> r_, m_, I_, tmp1_;                                        // (N)
     std::vector<Index> id_, pos_;                                            // (N)
     std::vector<WallRecord<T>> wall_rec_;                                    // (walls)
