@@ -3,8 +3,10 @@
 //
 // - Particles live in cell order (re-sorted at every neighbour-list rebuild, the box's shortest axis
 //   fastest) with their ids kept; the state is a structure of arrays, each vector quantity three
-//   contiguous component blocks (x then y then z) as in arrays, so the Gear predictor and corrector are
-//   single vectorised streams over 3N.
+//   contiguous component blocks (x then y then z) as in arrays, so the Gear scheme runs as vectorised
+//   streams. Between two force passes one pass over the particles does the corrector of one step fused
+//   with the predictor of the next, the displacement check, the kernel's records and the wall
+//   candidates (predict()).
 // - The contact candidates come from a neighbour list with a skin, rebuilt only when a displacement
 //   check says it must be. The list is a superset of the contact set and the shared law alone decides
 //   h > 0, so the contacts, and with the canonical order the trajectory, are those of a search every step.
@@ -12,12 +14,12 @@
 //   pair kernel writes each contact's force and torques into its slot; each particle then gathers, in
 //   the canonical order of physics.md §6, the slots where it is j (partners of lower id, ascending; a
 //   list kept across steps), then its own slots (partners of higher id, ascending, contiguous), then its
-//   walls; Newton's law follows in a vectorised pass. Kernel and sums go in one sweep over the storage
+//   walls; Newton's law comes with the corrector in the next pass. Kernel and sums go in one sweep over the storage
 //   order, a chunk of particles at a time, and the sums read the slots from a small ring that stays in
 //   cache (see forces_canonical). No sum depends on which thread did what, so the bits do not depend on the
 //   thread count.
 // - The kernel reads each particle's position, radius, velocity and angular velocity from one record
-//   (Kin, refreshed at the start of the force pass) and moves a pack's worth between records and lanes
+//   (Kin, written by predict()'s pass) and moves a pack's worth between records and lanes
 //   by transposes of whole vectors.
 // - FastOptions::canonical = false drops the canonical order: each pair's force is added to both
 //   particles as it is computed, into per-thread loads summed after a barrier, which is what an
@@ -95,8 +97,8 @@ struct SlotSource {
 template <class T>
 using Quad = Pack<T, 4>;
 
-// A particle's kinematics as the pair kernel reads them, one record per particle (refreshed at the start
-// of each force pass): position and radius, velocity, angular velocity, a quad each, so that a lane's
+// A particle's kinematics as the pair kernel reads them, one record per particle (written by
+// predict()'s pass, and by a rebuild): position and radius, velocity, angular velocity, a quad each, so that a lane's
 // particle is three loads of one record, not ten from ten arrays.
 template <class T>
 struct alignas(sizeof(Quad<T>)) Kin {
@@ -830,8 +832,8 @@ private:
     }
 
     // Particle s's sum in the canonical order: as j (partners of lower id, ascending), as i (partners of
-    // higher id, ascending), its walls in wall order, into f_ and t_ (Newton's law follows in a pass of
-    // its own: done here, a grain at a time, its six scalar divisions made the force pass 5 % longer,
+    // higher id, ascending), its walls in wall order, into f_ and t_ (Newton's law comes in the next step's pass,
+    // vectorised, with the corrector: done here, a grain at a time, its six scalar divisions made the force pass 5 % longer,
     // measured at 16000 grains on one thread and at 10⁵ on two). The slots from `from`.
     // The three components of a sum go as lanes of one quad (lane by lane, the scalar additions; x - y is
     // x + (-y)), each read as the quad that starts at it in the slot: f, t_i and t_j are three consecutive
