@@ -38,8 +38,9 @@ PHASES = ["predict", "search", "forces", "correct"]
 # acceleration and write the six back; three components, translation and rotation. A corrector pass and
 # a predictor pass of their own move more, each reading the six values again (predictor: reads 6,
 # writes 5; corrector: reads 7, writes 6: 1152 B); a variant that fuses the corrector into the next
-# step's predictor (fast) moves the minimum, and its driver-timed predictor holds both. The bound is
-# therefore set for the two phases together, whichever of them a variant does the work in.
+# step's predictor (fast) moves the minimum, and its driver-timed predictor holds both (fast's also the
+# other per-particle work of its one pass). The bound is therefore set for the two phases together,
+# whichever of them a variant does the work in.
 GEAR_DOUBLES = (7 + 6) * 3 * 2
 GEAR_SEPARATE_DOUBLES = {"predict": (6 + 5) * 3 * 2, "correct": (7 + 6) * 3 * 2}
 
@@ -301,7 +302,8 @@ def where(df, prov, callgrind, out, figs, suffix):
                   "STREAM bandwidth at that thread count, for predictor and corrector together: a variant that runs them as "
                   f"separate passes moves {sum(GEAR_SEPARATE_DOUBLES.values()) * 8} B (predict {GEAR_SEPARATE_DOUBLES['predict'] * 8}, "
                   f"correct {GEAR_SEPARATE_DOUBLES['correct'] * 8}); fast runs its corrector fused into the next step's predictor, "
-                  "so its predict holds both. Below the bound means the arrays still sat in cache (small N)."]
+                  "so its predict holds both, and with them Newton's law, the displacement check, the kernel's records and the "
+                  "wall candidates (docs/variants.md, \"fast\"). Below the bound means the arrays still sat in cache (small N)."]
     if callgrind:
         lines += ["", "Instructions per particle-step (valgrind --tool=callgrind, repeatable whatever the machine's load):", "",
                   "| variant | scene | N | steps | predict | search | forces | correct | total | contacts/particle |", "|---|---|---|---|---|---|---|---|---|---|"]

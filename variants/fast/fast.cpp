@@ -14,13 +14,13 @@
 //   pair kernel writes each contact's force and torques into its slot; each particle then gathers, in
 //   the canonical order of physics.md §6, the slots where it is j (partners of lower id, ascending; a
 //   list kept across steps), then its own slots (partners of higher id, ascending, contiguous), then its
-//   walls; Newton's law comes with the corrector in the next pass. Kernel and sums go in one sweep over the storage
-//   order, a chunk of particles at a time, and the sums read the slots from a small ring that stays in
-//   cache (see forces_canonical). No sum depends on which thread did what, so the bits do not depend on the
-//   thread count.
+//   walls; Newton's law comes with the corrector in the next pass. Kernel and sums go in one sweep over
+//   the storage order, a chunk of particles at a time, and the sums read the slots from a small ring
+//   that stays in cache (see forces_canonical). No sum depends on which thread did what, so the bits do
+//   not depend on the thread count.
 // - The kernel reads each particle's position, radius, velocity and angular velocity from one record
-//   (Kin, written by predict()'s pass) and moves a pack's worth between records and lanes
-//   by transposes of whole vectors.
+//   (Kin, written by predict()'s pass) and moves a pack's worth between records and lanes by transposes
+//   of whole vectors.
 // - FastOptions::canonical = false drops the canonical order: each pair's force is added to both
 //   particles as it is computed, into per-thread loads summed after a barrier, which is what an
 //   unordered code does; it keeps no slots.
@@ -97,9 +97,9 @@ struct SlotSource {
 template <class T>
 using Quad = Pack<T, 4>;
 
-// A particle's kinematics as the pair kernel reads them, one record per particle (written by
-// predict()'s pass, and by a rebuild): position and radius, velocity, angular velocity, a quad each, so that a lane's
-// particle is three loads of one record, not ten from ten arrays.
+// A particle's kinematics as the pair kernel reads them, one record per particle (written by predict()'s
+// pass, and by a rebuild): position and radius, velocity, angular velocity, a quad each, so that a
+// lane's particle is three loads of one record, not ten from ten arrays.
 template <class T>
 struct alignas(sizeof(Quad<T>)) Kin {
     Quad<T> xr;  // x, y, z, R
@@ -832,9 +832,10 @@ private:
     }
 
     // Particle s's sum in the canonical order: as j (partners of lower id, ascending), as i (partners of
-    // higher id, ascending), its walls in wall order, into f_ and t_ (Newton's law comes in the next step's pass,
-    // vectorised, with the corrector: done here, a grain at a time, its six scalar divisions made the force pass 5 % longer,
-    // measured at 16000 grains on one thread and at 10⁵ on two). The slots from `from`.
+    // higher id, ascending), its walls in wall order, into f_ and t_ (Newton's law comes in the next
+    // step's pass, vectorised, with the corrector: done here, a grain at a time, its six scalar divisions
+    // made the force pass 5 % longer, measured at 16000 grains on one thread and at 10⁵ on two). The
+    // slots from `from`.
     // The three components of a sum go as lanes of one quad (lane by lane, the scalar additions; x - y is
     // x + (-y)), each read as the quad that starts at it in the slot: f, t_i and t_j are three consecutive
     // values, and the fourth lane, the next value along, is not used.
