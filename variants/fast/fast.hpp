@@ -12,7 +12,7 @@ namespace demmat {
 struct FastOptions {
     // Neighbour-list skin in units of R_max: pairs closer than R_i + R_j + skin are listed, and the list
     // is rebuilt (particles re-sorted into cell order) when twice the largest displacement since the
-    // last rebuild plus the largest wall displacement passes 0.9·skin. 0 rebuilds every step.
+    // last rebuild passes 0.9·skin (walls need no list: each is tested every step). 0 rebuilds every step.
     double skin = 0.3;
     // true: each particle's force is summed in the canonical order of physics.md §6 (bit-identical to
     // arrays for any thread count). false: plain accumulation in storage order, each pair's force added
