@@ -1062,6 +1062,9 @@ private:
     // wall_contacts computes and the unordered sums add through this cursor.
     WallCursor wall_cursor(std::size_t t) { return {wall_cand_[t].data(), wall_res_[t].data(), wall_cand_[t].size()}; }
 
+    // Unordered: each pair's force added to both particles as the pack computes it, into loads of the
+    // thread's own (zeroed over the span of particles its slots reach, set at the rebuild), then each
+    // particle's loads summed over the threads whose span holds it, in thread order, and its walls.
     void forces_unordered()
     {
         const std::size_t n = n_;
