@@ -682,7 +682,6 @@ private:
         const Index* last_chunk = last_chunk_.data();
         const std::size_t chunks = (n + kChunk - 1) / kChunk, span = span_chunks_;
         const std::size_t limit = std::size_t(thread_limit());
-        per_thread_walls();
         per_thread_claims();
         if (rings_.size() < limit) rings_.resize(limit);
 #pragma omp parallel reduction(+ : pp, pw) if (par_)
@@ -1070,7 +1069,6 @@ private:
         const std::size_t n = n_;
         const std::size_t limit = std::size_t(thread_limit());
         if (loads_.size() < limit) loads_.resize(limit);
-        per_thread_walls();
         std::int64_t pp = 0, pw = 0;
 #pragma omp parallel reduction(+ : pp, pw) if (par_)
         {
