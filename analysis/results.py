@@ -245,7 +245,7 @@ def save_figure(fig, path, foot=None, dpi=150, fontsize=6.5, top=1.0):
     bottom = 0.0
     if foot:
         width_pt = fig.get_figwidth() * 72.0
-        chars = max(40, int(width_pt / (fontsize * 0.52)))
+        chars = max(40, int(0.95 * width_pt / (fontsize * 0.56)))
         text = "\n".join(textwrap.wrap(foot, chars))
         lines = text.count("\n") + 1
         bottom = (lines * fontsize * 1.3 + 8) / (fig.get_figheight() * 72.0)
