@@ -30,7 +30,7 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from atomic_io import atomic_write, write_text  # noqa: E402
-from results import (PAPER_JSON, PHASES, footer, legend_outside, load, n_axis, remove_stale, save_figure, spread, style,  # noqa: E402
+from results import (PAPER_JSON, PHASES, footer, legend_outside, load, load_paper, n_axis, remove_stale, save_figure, spread, style,  # noqa: E402
                      variant_key, wide)
 
 # Compulsory memory traffic of the 5th-order Gear scheme with rotation, per particle and step, in
@@ -329,7 +329,7 @@ def main(argv):
     ap.add_argument("--paper", default=PAPER_JSON, help="the paper's figures (default: data/paper.json in the repository)")
     a = ap.parse_args(argv)
     df, prov = read(a.bench)
-    paper = json.load(open(a.paper)) if os.path.exists(a.paper) else {}
+    paper = load_paper(a.paper)
     cg = [load(f).meta for f in a.callgrind]
     parts = [figure4(df, prov, paper, a.out, a.figures, a.suffix), cellsize(df, prov, a.out, a.figures, a.suffix),
              scaling(df, prov, a.out, a.figures, a.suffix), where(df, prov, cg, a.out, a.figures, a.suffix)]

@@ -191,7 +191,8 @@ def cmd_physics(a):
     files = sorted(glob.glob(os.path.join(a.work, "obs_*.csv")))
     if not files:
         sys.exit("plot_peers.py: no observables in " + a.work)
-    write_physics(pd.concat([pd.read_csv(f) for f in files]), json.load(open(a.versions)), particles, amplitude, out, figure)
+    write_physics(pd.concat([pd.read_csv(f) for f in files]), json.load(open(a.versions)), a.particles, a.amplitude,
+                  a.out, a.figure)
 
 
 def write_physics(df, versions, particles, amplitude, out, figure):

@@ -8,8 +8,6 @@ Reads structured fields only; nothing is parsed out of labels.
 Usage: /usr/bin/python3 analysis/plot_phases.py BENCH.json --figure OUT.png --table OUT.csv [--markdown OUT.md]
 """
 import argparse
-import json
-import os
 import sys
 
 import matplotlib
@@ -18,8 +16,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from atomic_io import atomic_write  # noqa: E402
-from results import PAPER_JSON, PHASES, bar_style, footer, legend_outside, load, save_figure, wide  # noqa: E402
+from atomic_io import atomic_write, write_text  # noqa: E402
+from results import PAPER_JSON, PHASES, bar_style, footer, legend_outside, load, load_paper, save_figure, wide  # noqa: E402
 
 GROUPS = PHASES + ["search_plus_forces", "total"]
 
@@ -102,10 +100,9 @@ def markdown(stats, order, res):
 def paper_ratios(stats, paper_json):
     """The paper's Figure 7 ratios (its three codes) beside this run's, when f90, oop and pascal ran."""
     have = set(stats.variant.astype(str))
-    if not {"f90", "oop"} <= have or not paper_json or not os.path.exists(paper_json):
+    paper = load_paper(paper_json).get("figure7_ratios_stated")
+    if not {"f90", "oop"} <= have or not paper:
         return ""
-    with open(paper_json) as f:
-        paper = json.load(f)["figure7_ratios_stated"]
     med = stats.assign(variant=stats.variant.astype(str), phase=stats.phase.astype(str)).set_index(["variant", "phase"])["median"]
 
     def fmt(v):
@@ -137,7 +134,7 @@ def main(argv):
     figure(stats, order, res, a.figure)
     if a.markdown:
         text = markdown(stats, [name for name, _, _ in order], res) + paper_ratios(stats, a.paper)
-        atomic_write(a.markdown, lambda tmp: open(tmp, "w").write(text))
+        write_text(a.markdown, text)
     print(stats.to_string(index=False, float_format=lambda x: f"{x:.4g}"))
 
 

@@ -104,10 +104,17 @@ def load(path):
     raise ValueError(f"{path}: not a result file of the suite (unknown schema)")
 
 
+def load_paper(path=PAPER_JSON):
+    """The paper's figures and claims (data/paper.json); {} where the file is absent."""
+    if not path or not os.path.exists(path):
+        return {}
+    with open(path) as f:
+        return json.load(f)
+
+
 def _bench(path, raw):
-    df = pd.DataFrame(raw["samples"]).rename(columns={"seconds_per_step": "seconds"})
-    if "threads" not in df:
-        df["threads"] = 0
+    df = pd.DataFrame(raw["samples"], columns=["variant", "threads", "repetition", "phase", "seconds_per_step"])
+    df = df.rename(columns={"seconds_per_step": "seconds"}).fillna({"threads": 0})
     df["N"] = raw["scene"]["particles"]
     df["sample"] = df.groupby(["variant", "threads", "repetition"], sort=False).ngroup()
     meta = {k: v for k, v in raw.items() if k not in ("samples", "provenance")}
