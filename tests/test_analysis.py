@@ -66,6 +66,24 @@ class Loader(unittest.TestCase):
                 results.load(f.name)
 
 
+class OneN(unittest.TestCase):
+    def test_no_curve_against_n_from_one_n(self):
+        """The sample has one N: scaling and where-the-time-goes are tables, and a stale figure goes."""
+        root = tempfile.mkdtemp()
+        try:
+            figs = os.path.join(root, "figures")
+            os.makedirs(figs)
+            open(os.path.join(figs, "scaling_one.png"), "w").close()  # left by other data
+            done = subprocess.run([sys.executable, os.path.join(ANALYSIS, "plot_figures.py"), os.path.join(DATA, "gbench_sample.json"),
+                                   "--out", root, "--figures", figs, "--suffix", "one"], capture_output=True, text=True, timeout=120)
+            self.assertEqual(done.returncode, 0, done.stderr)
+            self.assertEqual(os.listdir(figs), [])
+            self.assertIn("| settled | fast | 2 | 8000 |", open(os.path.join(root, "scaling.md")).read())
+            self.assertIn("| 8000 | 1 | forces |", open(os.path.join(root, "where_the_time_goes.md")).read())
+        finally:
+            shutil.rmtree(root)
+
+
 class Report(unittest.TestCase):
     def test_sections_present_and_missing(self):
         root = tempfile.mkdtemp()
