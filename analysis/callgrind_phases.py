@@ -13,6 +13,7 @@ import re
 import sys
 
 from atomic_io import write_text
+from results import load
 
 PATTERNS = {"predict": r"::predict\(long\)", "search": r"::search\(\)", "forces": r"::forces\(\)", "correct": r"::correct\(\)"}
 
@@ -24,10 +25,13 @@ def main(argv):
     ap.add_argument("--steps", type=int, required=True)
     ap.add_argument("-o", "--out", required=True)
     a = ap.parse_args(argv)
-    run = json.load(open(a.run_json))
+    res = load(a.run_json)
+    run = dict(res.meta, provenance=res.provenance)
     best = {p: 0 for p in PATTERNS}
     line_re = re.compile(r"^\s*([\d,]+)\s+(?:\([^)]*\)\s+)?\S*:(.*)$")
-    for line in open(a.annotate, errors="replace"):
+    with open(a.annotate, errors="replace") as f:
+        lines = f.readlines()
+    for line in lines:
         m = line_re.match(line)
         if not m:
             continue

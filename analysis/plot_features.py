@@ -12,7 +12,6 @@ Reads the label of every repetition (a JSON object: variant, level, kernel, mode
 Usage: /usr/bin/python3 analysis/plot_features.py BENCH.json --figure OUT.png --markdown OUT.md [--table OUT.csv]
 """
 import argparse
-import json
 import sys
 
 import matplotlib
@@ -22,30 +21,21 @@ import matplotlib.pyplot as plt  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from atomic_io import atomic_write, write_text  # noqa: E402
+from results import PHASES, footer, load, save_figure, wide  # noqa: E402
 
-PHASES = ["predict", "search", "forces", "correct"]
 # The GPU study of this group's code the issue quotes: over normal forces alone, history-dependent
 # friction +38 %, torques +4 %.
 GPU_STUDY = {"friction": 0.38, "torques": 0.04}
 
 
-def samples(bench):
-    rows = []
-    for b in bench["benchmarks"]:
-        if b.get("run_type") != "iteration" or not b.get("label"):
-            continue
-        lab = json.loads(b["label"])
-        if lab.get("family") != "features":
-            continue
-        row = dict(lab)
-        row["repetition"] = b.get("repetition_index", 0)
-        for p in PHASES + ["total"]:
-            row[p] = b[f"{p}_s"]
-        row["contacts_per_particle"] = b["contacts_per_particle"]
-        rows.append(row)
-    if not rows:
+def samples(res):
+    """One row per repetition of a features benchmark: its label's fields and the phases' seconds per step."""
+    df = wide(res.table)
+    df = df[df.get("family", pd.Series(dtype=str)) == "features"] if "family" in df else df.iloc[:0]
+    if df.empty:
         sys.exit("plot_features.py: no features benchmarks in the file")
-    return pd.DataFrame(rows)
+    df = df.rename(columns={f"{p}_s": p for p in PHASES + ["total"]})
+    return df.reset_index(drop=True)
 
 
 def table(df):
@@ -79,17 +69,16 @@ def pct(x):
     return "" if pd.isna(x) else f"{x * 100:+.1f} %"
 
 
-def markdown(t, ctx):
+def markdown(t, prov):
     lines = [
         "# What each model feature costs per step",
         "",
         f"Produced by scripts/run_features.sh (bench/bench_features.cpp, analysis/plot_features.py) on "
-        f"{ctx.get('demmat_cpu', '?')}, {ctx.get('demmat_compiler', '?')} {ctx.get('demmat_flags', '')}, "
-        f"commit {ctx.get('demmat_commit', '?')}{' (dirty)' if ctx.get('demmat_dirty') in ('true', True) else ''}, "
-        f"{ctx.get('demmat_date', ctx.get('date', '?'))}.",
+        f"{prov.get('cpu', '?')}, {prov.get('compiler', '?')} {prov.get('flags', '')}, "
+        f"commit {prov.get('commit', '?')}{' (dirty)' if prov.get('dirty') else ''}, {prov.get('date', '?')}.",
         "",
         "A monodisperse dense bed settled for "
-        f"{ctx.get('demmat_settle_time_s', '?')} s; each level's scene needs one feature more than the one above. "
+        f"{prov.get('settle_time_s', '?')} s; each level's scene needs one feature more than the one above. "
         "*specialised*: the model the variant picks for the scene; *full*: the paper's full model on the same "
         "scene (the same trajectory, bit for bit). Times are medians over the interleaved repetitions of "
         "milliseconds per step (min–max in brackets). *vs normal*: the whole step against the normal-force-only "
@@ -119,7 +108,7 @@ def markdown(t, ctx):
     return "\n".join(lines)
 
 
-def figure(t, path):
+def figure(t, prov, path):
     variants = list(dict.fromkeys(t.variant))
     fig, axes = plt.subplots(1, len(variants), figsize=(6.5 * len(variants), 4.8), squeeze=False, sharey=True)
     colours = {"predict": "#4c72b0", "search": "#dd8452", "forces": "#c44e52", "correct": "#55a868"}
@@ -143,8 +132,9 @@ def figure(t, path):
         ax.grid(axis="y", alpha=0.3)
     axes[0][0].set_ylabel("ms per step (median; phases of the specialised run)")
     fig.legend(loc="upper center", ncol=5, fontsize=8, bbox_to_anchor=(0.5, 1.0))
-    fig.tight_layout(rect=(0, 0, 1, 0.93))
-    atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=130, format="png"))
+    n = int(t.attrs.get("N", 0))
+    save_figure(fig, path, footer(prov, f"{n} grains, dense bed settled {prov.get('settle_time_s', '?')} s",
+                                  f"median of {int(t.repetitions.max())} interleaved repetitions"), dpi=130, top=0.93)
 
 
 def main():
@@ -155,17 +145,17 @@ def main():
     ap.add_argument("--table")
     a = ap.parse_args()
     try:
-        with open(a.bench) as f:
-            bench = json.load(f)
+        res = load(a.bench)
     except (OSError, ValueError) as e:
         sys.exit(f"plot_features.py: cannot read {a.bench}: {e}")
-    t = table(samples(bench))
-    ctx = bench.get("context", {})
-    text = markdown(t, ctx)
+    df = samples(res)
+    t = table(df)
+    t.attrs["N"] = int(df["N"].max())
+    text = markdown(t, res.provenance)
     write_text(a.markdown, text)
     if a.table:
         atomic_write(a.table, lambda tmp: t.to_csv(tmp, index=False, float_format="%.6g"))
-    figure(t, a.figure)
+    figure(t, res.provenance, a.figure)
     print(text)
 
 

@@ -30,8 +30,8 @@ import numpy as np  # noqa: E402
 import pandas as pd  # noqa: E402
 
 from atomic_io import atomic_write, write_text  # noqa: E402
-
-PHASES = ["predict", "search", "forces", "correct"]
+from results import (PAPER_JSON, PHASES, footer, legend_outside, load, load_paper, n_axis, remove_stale, save_figure, spread, style,  # noqa: E402
+                     variant_key, wide)
 
 # Compulsory memory traffic of the 5th-order Gear scheme with rotation, per particle and step, in
 # doubles (physics.md §3): a step must read the six Gear values of each degree of freedom and the new
@@ -45,49 +45,25 @@ GEAR_DOUBLES = (7 + 6) * 3 * 2
 GEAR_SEPARATE_DOUBLES = {"predict": (6 + 5) * 3 * 2, "correct": (7 + 6) * 3 * 2}
 
 
-def save_fig(fig, path):
-    atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=150, format="png"))
-    plt.close(fig)
+def read(path):
+    """The benchmarks, one row per repetition (phases as <phase>_s columns), and the run's provenance."""
+    res = load(path)
+    return wide(res.table).rename(columns={"N": "particles"}), res.provenance
 
 
-def load(path):
-    with open(path) as f:
-        raw = json.load(f)
-    ctx = raw["context"]
-    rows = []
-    for b in raw["benchmarks"]:
-        if b.get("run_type") != "iteration" or "label" not in b or b.get("error_occurred"):
-            continue
-        row = json.loads(b["label"])
-        row["repetition"] = b.get("repetition_index", 0)
-        for k, v in b.items():
-            if isinstance(v, (int, float)) and k not in row:
-                row[k] = v
-        rows.append(row)
-    df = pd.DataFrame(rows)
-    if "particles" in df:
-        df["particles"] = df["particles"].astype("Int64")  # a count: printed without a decimal point
-    prov = {k[len("demmat_"):]: v for k, v in ctx.items() if k.startswith("demmat_")}
-    prov["host_cpus"] = ctx.get("num_cpus")
-    prov["mhz_per_cpu"] = ctx.get("mhz_per_cpu")
-    return df, prov
+def caption(prov, *extra):
+    return footer(prov, f"{prov.get('sweep', '')} sweep", *extra)
 
 
-def caption(prov, extra=""):
-    dirty = " (dirty)" if str(prov.get("dirty")) == "true" else ""
-    return (f"{prov.get('cpu', '?')}, {prov.get('host_cpus', '?')} CPUs · {prov.get('compiler', '?')} {prov.get('flags', '')} · "
-            f"commit {str(prov.get('commit', '?'))[:10]}{dirty} · {prov.get('date', '')} · {prov.get('sweep', '')} sweep{extra}")
-
-
-def med(df, keys, cols):
-    g = df.groupby(keys)[cols]
-    out = g.median()
-    lo, hi = g.min(), g.max()
-    for c in cols:
-        out[c + "_min"] = lo[c]
-        out[c + "_max"] = hi[c]
-    out["repetitions"] = g.size()
-    return out.reset_index()
+def single_n(m, name, figs, suffix):
+    """A curve against N needs more than one N: with one, the table says it all and no figure is drawn
+    (a stale one from other data is removed)."""
+    if m.particles.nunique() > 1:
+        return False
+    path = os.path.join(figs, f"{name}_{suffix}.png")
+    if remove_stale(path):
+        print(f"plot_figures.py: one N only: removed {path}; the table has the numbers", file=sys.stderr)
+    return True
 
 
 # ---- Figure 4 ----------------------------------------------------------------------------------------
@@ -101,7 +77,7 @@ def figure4(df, prov, paper, out, figs, suffix):
     d = df[df.family == "figure4"]
     if d.empty:
         return ""
-    m = med(d, ["search", "particles"], ["total_s", "search_s"])
+    m = spread(d, ["search", "particles"], ["total_s", "search_s"])
     m["t_1e4_cycles_s"] = m["total_s"] * 1e4
     m["t_1e4_min"], m["t_1e4_max"] = m["total_s_min"] * 1e4, m["total_s_max"] * 1e4
     names = {"cells_2rmax": "cells 2·Rmax", "cells_4rmax": "cells 4·Rmax", "all_pairs": "no cells (all pairs)"}
@@ -129,10 +105,8 @@ def figure4(df, prov, paper, out, figs, suffix):
     ax.set_ylabel("CPU time for 10⁴ cycles (s)")
     ax.set_title("Figure 4: contact search with and without cells (the paper's 2 m box)", fontsize=10)
     ax.grid(which="both", alpha=0.3)
-    ax.legend(fontsize=7)
-    fig.text(0.01, 0.01, caption(prov, " · arrays variant, 1 thread; time per step × 10⁴"), fontsize=5.5)
-    fig.tight_layout(rect=(0, 0.04, 1, 1))
-    save_fig(fig, os.path.join(figs, f"figure4_{suffix}.png"))
+    ax.legend(fontsize=7, loc="best")
+    save_figure(fig, os.path.join(figs, f"figure4_{suffix}.png"), caption(prov, "arrays variant, 1 thread; time per step × 10⁴"))
 
     atomic_write(os.path.join(out, "figure4.csv"), lambda tmp: m.to_csv(tmp, index=False, float_format="%.6g"))
     lines = ["| N | cells 2·Rmax (s) | cells 4·Rmax (s) | no cells (s) | no cells / 2·Rmax | no cells / 4·Rmax |", "|---|---|---|---|---|---|"]
@@ -172,23 +146,24 @@ def cellsize(df, prov, out, figs, suffix):
     d = df[df.family == "cellsize"]
     if d.empty:
         return ""
-    m = med(d, ["variant", "particles", "cell_size_rmax"], ["total_s", "search_s", "forces_s", "candidates_per_particle"])
+    m = spread(d, ["variant", "particles", "cell_size_rmax"], ["total_s", "search_s", "forces_s", "candidates_per_particle"])
     fig, axes = plt.subplots(1, 2, figsize=(10, 4.2))
+    sizes = sorted(m.particles.unique())
     for (v, n), sub in m.groupby(["variant", "particles"]):
         sub = sub.sort_values("cell_size_rmax")
-        axes[0].plot(sub.cell_size_rmax, sub.total_s / n * 1e6, "o-", ms=3, label=f"{v}, N = {n}")
-        axes[1].plot(sub.cell_size_rmax, sub.candidates_per_particle, "o-", ms=3, label=f"{v}, N = {n}")
+        kw = style(v)
+        kw["linestyle"] = ["-", "--", ":", "-."][sizes.index(n) % 4]  # the variant's colour, a line per N
+        axes[0].plot(sub.cell_size_rmax, sub.total_s / n * 1e6, label=f"{v}, N = {n}", **kw)
+        axes[1].plot(sub.cell_size_rmax, sub.candidates_per_particle, label=f"{v}, N = {n}", **kw)
     axes[0].set_ylabel("µs per particle-step")
     axes[1].set_ylabel("candidate pairs per particle")
     for ax in axes:
         ax.set_xlabel("cell edge / Rmax")
         ax.grid(alpha=0.3)
-        ax.legend(fontsize=7)
+    legend_outside(axes[1])
     axes[0].set_title("Time per step against cell size (settled bed)", fontsize=10)
     axes[1].set_title("Candidates the search keeps", fontsize=10)
-    fig.text(0.01, 0.01, caption(prov, " · 1 thread"), fontsize=5.5)
-    fig.tight_layout(rect=(0, 0.04, 1, 1))
-    save_fig(fig, os.path.join(figs, f"cellsize_{suffix}.png"))
+    save_figure(fig, os.path.join(figs, f"cellsize_{suffix}.png"), caption(prov, "1 thread"))
     atomic_write(os.path.join(out, "cellsize.csv"), lambda tmp: m.to_csv(tmp, index=False, float_format="%.6g"))
     lines = ["| variant | N | best cell edge / Rmax | µs/particle-step at best | at 2·Rmax | at 4·Rmax |", "|---|---|---|---|---|---|"]
     for (v, n), sub in m.groupby(["variant", "particles"]):
@@ -211,28 +186,10 @@ def scaling(df, prov, out, figs, suffix):
     cols = ["us_per_particle_step", "predict_s", "search_s", "forces_s", "correct_s", "total_s", "contacts_per_particle",
             "candidates_per_particle", "memory_bytes_per_particle", "forces_ns_per_contact", "forces_ns_per_candidate",
             "search_ns_per_candidate"]
-    m = med(d, ["state", "series", "variant", "threads", "particles"], cols)
+    m = spread(d, ["state", "series", "variant", "threads", "particles"], cols)
     atomic_write(os.path.join(out, "phases.csv"), lambda tmp: m.to_csv(tmp, index=False, float_format="%.6g"))
-    states = [s for s in ["loose", "settled", "compression"] if s in set(m.state)]
-    fig, axes = plt.subplots(1, len(states), figsize=(5 * len(states), 4.5), sharey=True, squeeze=False)
-    for ax, s in zip(axes[0], states):
-        for k, (series, sub) in enumerate(m[m.state == s].groupby("series", sort=False)):
-            sub = sub.sort_values("particles")
-            ax.errorbar(sub.particles, sub.us_per_particle_step,
-                        yerr=[sub.us_per_particle_step - sub.us_per_particle_step_min, sub.us_per_particle_step_max - sub.us_per_particle_step],
-                        fmt="o-" if "threads" not in series else "s--", ms=3, lw=1, capsize=2, label=series, color=f"C{k % 10}")
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel("particles N")
-        ax.set_title(f"{s}", fontsize=10)
-        ax.grid(which="both", alpha=0.3)
-    axes[0][0].set_ylabel("µs per particle-step (median, min–max)")
-    axes[0][-1].legend(fontsize=6.5, ncol=1)
-    fig.suptitle("Scaling: cost per particle-step against N", fontsize=11)
-    fig.text(0.01, 0.01, caption(prov), fontsize=5.5)
-    fig.tight_layout(rect=(0, 0.04, 1, 1))
-    save_fig(fig, os.path.join(figs, f"scaling_{suffix}.png"))
-
+    if not single_n(m, "scaling", figs, suffix):
+        scaling_figure(m, prov, figs, suffix)
     lines = ["| state | variant | threads | N | µs/particle-step | predict | search | forces | correct | contacts/particle | bytes/particle |",
              "|---|---|---|---|---|---|---|---|---|---|---|"]
     for _, r in m.sort_values(["state", "particles", "us_per_particle_step"]).iterrows():
@@ -245,6 +202,27 @@ def scaling(df, prov, out, figs, suffix):
     return text
 
 
+def scaling_figure(m, prov, figs, suffix):
+    states = [s for s in ["loose", "settled", "compression"] if s in set(m.state)]
+    fig, axes = plt.subplots(1, len(states), figsize=(4.2 * len(states), 4.2), sharey=True, squeeze=False)
+    for ax, s in zip(axes[0], states):
+        for (variant, threads), sub in m[m.state == s].groupby(["variant", "threads"], sort=False):
+            sub = sub.sort_values("particles")
+            ax.errorbar(sub.particles, sub.us_per_particle_step,
+                        yerr=[sub.us_per_particle_step - sub.us_per_particle_step_min, sub.us_per_particle_step_max - sub.us_per_particle_step],
+                        lw=1, capsize=2, label=variant + (f" ×{threads} threads" if threads > 1 else ""), **style(variant, threads))
+        n_axis(ax, m.particles)
+        ax.set_yscale("log")
+        ax.set_title(f"{s}", fontsize=10)
+        ax.grid(which="both", alpha=0.3)
+    axes[0][0].set_ylabel("µs per particle-step (median, min–max)")
+    handles, labels = axes[0][0].get_legend_handles_labels()
+    order = sorted(range(len(labels)), key=lambda k: variant_key(labels[k]))
+    legend_outside(axes[0][-1], [handles[k] for k in order], [labels[k] for k in order])
+    fig.suptitle("Scaling: cost per particle-step against N", fontsize=11)
+    save_figure(fig, os.path.join(figs, f"scaling_{suffix}.png"), caption(prov))
+
+
 # ---- where the time goes -------------------------------------------------------------------------------
 
 def where(df, prov, callgrind, out, figs, suffix):
@@ -254,7 +232,7 @@ def where(df, prov, callgrind, out, figs, suffix):
         return ""
     bw = {}
     if not st.empty:
-        s = med(st, ["kernel", "threads"], ["bandwidth_GBps"])
+        s = spread(st, ["kernel", "threads"], ["bandwidth_GBps"])
         for t, sub in s.groupby("threads"):
             bw[int(t)] = sub.set_index("kernel").bandwidth_GBps
         atomic_write(os.path.join(out, "stream.csv"), lambda tmp: s.to_csv(tmp, index=False, float_format="%.6g"))
@@ -263,7 +241,7 @@ def where(df, prov, callgrind, out, figs, suffix):
     # The settled bed where the run has it; otherwise what it has (a slice of the sweep, e.g. the 10⁶ loose grid).
     state = "settled" if "settled" in set(ph.state) else sorted(set(ph.state))[0]
     state_name = {"settled": "settled bed", "loose": "loose grid", "compression": "compression stage"}.get(state, state)
-    m = med(ph[ph.state == state], ["variant", "threads", "particles"], cols)
+    m = spread(ph[ph.state == state], ["variant", "threads", "particles"], cols)
     bitwise = ph.groupby("variant")["bitwise"].first() if "bitwise" in ph else None
     # The fastest bit-identical variant at the largest N, one thread.
     one = m[(m.threads == 1)]
@@ -314,8 +292,13 @@ def where(df, prov, callgrind, out, figs, suffix):
     text = "\n".join(lines) + "\n"
     write_text(os.path.join(out, "where_the_time_goes.md"), text)
 
-    # Figure: per-phase ns per particle-step against N for the fastest variant, with the bandwidth bounds.
-    sub = m[(m.variant == fastest)].sort_values("particles")
+    if not single_n(m[m.variant == fastest], "where", figs, suffix):
+        where_figure(m[m.variant == fastest].sort_values("particles"), fastest, state_name, bw, prov, figs, suffix)
+    return text
+
+
+def where_figure(sub, fastest, state_name, bw, prov, figs, suffix):
+    """Per-phase ns per particle-step against N for the fastest variant, with the bandwidth bound."""
     fig, ax = plt.subplots(figsize=(7, 4.5))
     for k, p in enumerate(PHASES):
         for t, s2 in sub.groupby("threads"):
@@ -326,18 +309,14 @@ def where(df, prov, callgrind, out, figs, suffix):
         ax.plot(s2.particles, (s2.predict_s + s2.correct_s) / s2.particles * 1e9, "o-" if t == 1 else "s--", color=f"C{k}", ms=3,
                 label="predict + correct" + (f" ({int(t)} threads)" if t > 1 else ""))
     if 1 in bw:
-        ax.axhline(GEAR_DOUBLES * 8 / bw[1].max(), color=f"C{k}", lw=0.8, ls=":", label="predict + correct: bandwidth bound, 1 thread")
-    ax.set_xscale("log")
+        ax.axhline(GEAR_DOUBLES * 8 / bw[1].max(), color=f"C{k}", lw=0.8, ls=":", label="predict + correct:\nbandwidth bound, 1 thread")
+    n_axis(ax, sub.particles)
     ax.set_yscale("log")
-    ax.set_xlabel("particles N")
     ax.set_ylabel("ns per particle-step")
     ax.set_title(f"Where the time goes: {fastest}, {state_name}", fontsize=10)
     ax.grid(which="both", alpha=0.3)
-    ax.legend(fontsize=6.5, ncol=2)
-    fig.text(0.01, 0.01, caption(prov), fontsize=5.5)
-    fig.tight_layout(rect=(0, 0.04, 1, 1))
-    save_fig(fig, os.path.join(figs, f"where_{suffix}.png"))
-    return text
+    legend_outside(ax)
+    save_figure(fig, os.path.join(figs, f"where_{suffix}.png"), caption(prov))
 
 
 def main(argv):
@@ -347,11 +326,11 @@ def main(argv):
     ap.add_argument("--figures", required=True, help="folder for PNG figures")
     ap.add_argument("--suffix", default="short", help="suffix of the figure names (short, full)")
     ap.add_argument("--callgrind", nargs="*", default=[], help="JSON files written by scripts/callgrind_phases.sh")
-    ap.add_argument("--paper", default=os.path.join(os.path.dirname(__file__), "..", "..", "shared", "data", "paper.json"))
+    ap.add_argument("--paper", default=PAPER_JSON, help="the paper's figures (default: data/paper.json in the repository)")
     a = ap.parse_args(argv)
-    df, prov = load(a.bench)
-    paper = json.load(open(a.paper)) if os.path.exists(a.paper) else {}
-    cg = [json.load(open(f)) for f in a.callgrind]
+    df, prov = read(a.bench)
+    paper = load_paper(a.paper)
+    cg = [load(f).meta for f in a.callgrind]
     parts = [figure4(df, prov, paper, a.out, a.figures, a.suffix), cellsize(df, prov, a.out, a.figures, a.suffix),
              scaling(df, prov, a.out, a.figures, a.suffix), where(df, prov, cg, a.out, a.figures, a.suffix)]
     write_text(os.path.join(a.out, "provenance.json"), json.dumps(prov, indent=1) + "\n")

@@ -9,6 +9,9 @@
       computed the same way for every code.
   plot_peers.py physics --work DIR --versions JSON --particles N --amplitude A --out DIR --figure PNG
       ensemble bands per code, a figure and a Markdown summary.
+  plot_peers.py replot-bench BENCH_PEERS.json --figure PNG
+  plot_peers.py replot-physics PHYSICS_N.csv --versions JSON --amplitude A --figure PNG
+      the tables and figures again from the files bench and physics wrote (results/peers/), beside them.
 """
 import argparse
 import glob
@@ -25,7 +28,8 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
-from atomic_io import atomic_write, write_text  # noqa: E402
+from atomic_io import write_text  # noqa: E402
+from results import footer, legend_outside, load, n_axis, save_figure, style, variant_key  # noqa: E402
 
 STAGES = ["loose", "bed", "compression"]
 STAGE_TITLE = {"loose": "loose grid (t = 0)", "bed": "settled bed", "compression": "compression stage"}
@@ -36,15 +40,19 @@ def cmd_bench(a):
     rows = pd.read_csv(a.samples).to_dict("records")
     provenance = None
     for f in sorted(glob.glob(os.path.join(a.work, "suite_n*_*_r*.json"))):
-        j = json.load(open(f))
-        provenance = provenance or j["provenance"]
+        res = load(f)
+        provenance = provenance or res.provenance
         stem = os.path.basename(f)[len("suite_n"):-len(".json")]
         n, stage, rep = stem.split("_")[0], "_".join(stem.split("_")[1:-1]), stem.split("_")[-1][1:]
-        for s in j["summary"]:
+        for s in res.meta["summary"]:
             rows.append({"code": "suite", "variant": s["variant"], "particles": int(n), "stage": stage,
-                         "repetition": int(rep), "steps": j["steps"],
+                         "repetition": int(rep), "steps": res.meta["steps"],
                          "seconds_per_step": s["seconds_per_step"]["total"]["median"]})
-    df = pd.DataFrame(rows)
+    write_bench(pd.DataFrame(rows), provenance, json.load(open(a.versions)), a.out, a.figure)
+
+
+def write_bench(df, provenance, versions, out, figure):
+    """Medians, ratios to LAMMPS, bench_peers.{csv,json,md} in out, and the figure, from every sample."""
     if df.empty:
         sys.exit("plot_peers.py: no samples")
     df["us_per_particle_step"] = df["seconds_per_step"] / df["particles"] * 1e6
@@ -53,15 +61,14 @@ def cmd_bench(a):
         .join(g.count().rename("repetitions")).reset_index()
     lam = med[med.code == "lammps"].set_index(["stage", "particles"])["median"]
     med["ratio_to_lammps"] = [r["median"] / lam.get((r["stage"], r["particles"]), float("nan")) for _, r in med.iterrows()]
-    versions = json.load(open(a.versions))
-    os.makedirs(a.out, exist_ok=True)
-    csv = os.path.join(a.out, "bench_peers.csv")
+    os.makedirs(out, exist_ok=True)
+    csv = os.path.join(out, "bench_peers.csv")
     write_text(csv, med.to_csv(index=False, float_format="%.6g"))
-    out = {"provenance": provenance, "peers": versions, "timing": {
+    doc = {"provenance": provenance, "peers": versions, "timing": {
         "suite": "demmat bench: sum of the four timed phases per step (health checks excluded), median over its own run",
         "peers": "the code's own 'Loop time of' for the timed run after a warm-up run, divided by its steps"},
         "summary": med.to_dict("records"), "samples": df.to_dict("records")}
-    write_text(os.path.join(a.out, "bench_peers.json"), json.dumps(out, indent=1) + "\n")
+    write_text(os.path.join(out, "bench_peers.json"), json.dumps(doc, indent=1) + "\n")
 
     # Figure: µs per particle-step against N, one panel per stage.
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.8), sharey=True)
@@ -70,22 +77,24 @@ def cmd_bench(a):
         for (code, variant), s in m.groupby(["code", "variant"]):
             s = s.sort_values("particles")
             peer = code != "suite"
+            kw = style(variant)
+            if peer:
+                kw.update(linewidth=2.5, linestyle="--" if code == "liggghts" else "-", markersize=6)
             ax.errorbar(s.particles, s["median"], yerr=[s["median"] - s["min"], s["max"] - s["median"]],
-                        label=variant if not peer else variant.upper(), marker="s" if peer else "o",
-                        linewidth=2.5 if peer else 1.0, color="black" if code == "lammps" else ("dimgray" if peer else None),
-                        linestyle="--" if code == "liggghts" else "-", capsize=2)
-        ax.set_xscale("log")
+                        label=variant if not peer else variant.upper(), linewidth=kw.pop("linewidth", 1.0), capsize=2, **kw)
+        n_axis(ax, med.particles)
         ax.set_yscale("log")
-        ax.set_xlabel("particles N")
         ax.set_title(STAGE_TITLE[stage])
         ax.grid(True, which="both", alpha=0.3)
     axes[0].set_ylabel("µs per particle-step (median, min–max)")
-    axes[-1].legend(fontsize=7, ncol=2)
+    handles, labels = axes[0].get_legend_handles_labels()
+    order = sorted(range(len(labels)), key=lambda k: variant_key(labels[k].lower()))
+    legend_outside(axes[-1], [handles[k] for k in order], [labels[k] for k in order])
     cpu = (provenance or {}).get("cpu", "")
     fig.suptitle(f"One core each: the suite's variants, LAMMPS {versions.get('lammps', '')}, "
                  f"LIGGGHTS {versions.get('liggghts', '')} ({cpu})", fontsize=10)
-    fig.tight_layout()
-    atomic_write(a.figure, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
+    save_figure(fig, figure, footer(provenance or {}, f"median of {int(med.repetitions.max())} interleaved repetitions, one core per code"),
+                dpi=110)
 
     # Markdown: ratio to LAMMPS (same run), per stage and N.
     lines = ["# The suite beside LAMMPS and LIGGGHTS: time per step relative to LAMMPS",
@@ -111,8 +120,8 @@ def cmd_bench(a):
         lam_row = [m[(m.variant == 'lammps') & (m.particles == n)]["median"] for n in ns]
         lines.append("| *LAMMPS µs per particle-step* | " + " | ".join("" if r.empty else f"{r.iloc[0]:.3f}" for r in lam_row) + " |")
         lines.append("")
-    write_text(os.path.join(a.out, "bench_peers.md"), "\n".join(lines))
-    print(f"results: {csv}, {os.path.join(a.out, 'bench_peers.json')}, {os.path.join(a.out, 'bench_peers.md')}, {a.figure}")
+    write_text(os.path.join(out, "bench_peers.md"), "\n".join(lines))
+    print(f"results: {csv}, {os.path.join(out, 'bench_peers.json')}, {os.path.join(out, 'bench_peers.md')}, {figure}")
 
 
 # ---- observables -----------------------------------------------------------------------------------------
@@ -182,8 +191,12 @@ def cmd_physics(a):
     files = sorted(glob.glob(os.path.join(a.work, "obs_*.csv")))
     if not files:
         sys.exit("plot_peers.py: no observables in " + a.work)
-    df = pd.concat([pd.read_csv(f) for f in files])
-    versions = json.load(open(a.versions))
+    write_physics(pd.concat([pd.read_csv(f) for f in files]), json.load(open(a.versions)), a.particles, a.amplitude,
+                  a.out, a.figure)
+
+
+def write_physics(df, versions, particles, amplitude, out, figure):
+    """Ensemble bands per code (figure), physics_<N>.csv (every frame) and physics_<N>.md in out."""
     panels = [("loose", "kinetic_energy", "kinetic energy (J), settling", True),
               ("loose", "bed_height", "bed height 2⟨z⟩ (m), settling", False),
               ("compression", "wall_force_x_max", "force on the moving wall (N), compression", False),
@@ -201,17 +214,19 @@ def cmd_physics(a):
         if logy:
             ax.set_yscale("log")
         ax.grid(alpha=0.3)
-    axes[0, 0].legend(fontsize=8)
-    fig.suptitle(f"{a.particles} grains, perturbed starts (velocity ±{a.amplitude} m/s): ensemble mean and min–max band per code", fontsize=10)
-    fig.tight_layout()
-    atomic_write(a.figure, lambda tmp: fig.savefig(tmp, dpi=110, format="png"))
+    axes[0, 0].legend(fontsize=8, loc="best")
+    fig.suptitle(f"{particles} grains, perturbed starts (velocity ±{amplitude} m/s): ensemble mean and min–max band per code", fontsize=10)
+    # The observables carry no build provenance of their own: the footer says what made them.
+    save_figure(fig, figure, f"LAMMPS {versions.get('lammps', '?')} (Debian {versions.get('lammps_package', '?')}) · LIGGGHTS "
+                f"{versions.get('liggghts', '?')} · the suite: arrays variant, the paper's Gear scheme · {df.member.nunique()} "
+                f"perturbed starts per code, the same data files for every code · scripts/run_peers.sh", dpi=110)
 
     # Summary: at a few times, each code's ensemble mean ± standard deviation, and the suite's and
     # LIGGGHTS's distance from LAMMPS in units of the pooled ensemble standard deviation.
-    os.makedirs(a.out, exist_ok=True)
-    write_text(os.path.join(a.out, f"physics_{a.particles}.csv"), df.to_csv(index=False, float_format="%.9g"))
-    lines = [f"# Physics cross-check: the suite, LAMMPS and LIGGGHTS from the same {a.particles} grains", "",
-             f"Each code ran {df.member.nunique()} perturbed starts (velocities ± {a.amplitude} m/s, the same data files for "
+    os.makedirs(out, exist_ok=True)
+    write_text(os.path.join(out, f"physics_{particles}.csv"), df.to_csv(index=False, float_format="%.9g"))
+    lines = [f"# Physics cross-check: the suite, LAMMPS and LIGGGHTS from the same {particles} grains", "",
+             f"Each code ran {df.member.nunique()} perturbed starts (velocities ± {amplitude} m/s, the same data files for "
              f"every code). Mean ± standard deviation over the ensemble; *z* = (code − LAMMPS) / pooled std. "
              f"LAMMPS {versions.get('lammps', '?')}, LIGGGHTS {versions.get('liggghts', '?')}. Produced by scripts/run_peers.sh. "
              f"Where the perturbations have not yet grown (the short compression window), the ensemble band is "
@@ -237,8 +252,22 @@ def cmd_physics(a):
                    if "suite" in mean.index and "lammps" in mean.index and mean["lammps"] != 0 else "")
             lines.append(f"| {t:.3f} | " + " | ".join(cells) + f" | {rel} | {z('suite')} | {z('liggghts')} |")
         lines.append("")
-    write_text(os.path.join(a.out, f"physics_{a.particles}.md"), "\n".join(lines))
-    print(f"results: {os.path.join(a.out, f'physics_{a.particles}.md')}, {a.figure}")
+    write_text(os.path.join(out, f"physics_{particles}.md"), "\n".join(lines))
+    print(f"results: {os.path.join(out, f'physics_{particles}.md')}, {figure}")
+
+
+def cmd_replot_bench(a):
+    """The tables and the figure again from bench_peers.json (every sample is in it), beside it."""
+    res = load(a.json)
+    df = res.table.drop(columns=["threads", "phase", "sample"]).rename(columns={"N": "particles", "seconds": "seconds_per_step"})
+    write_bench(df.drop(columns=["us_per_particle_step"]), res.provenance, res.meta["peers"], os.path.dirname(a.json), a.figure)
+
+
+def cmd_replot_physics(a):
+    """The summary and the figure again from physics_<N>.csv (every frame of every code), beside it."""
+    n = int(os.path.basename(a.csv)[len("physics_"):-len(".csv")])
+    versions = load(a.versions).meta["peers"] if a.versions.endswith("bench_peers.json") else json.load(open(a.versions))
+    write_physics(pd.read_csv(a.csv), versions, n, a.amplitude, os.path.dirname(a.csv), a.figure)
 
 
 def main():
@@ -264,8 +293,17 @@ def main():
     p.add_argument("--amplitude", required=True)
     p.add_argument("--out", required=True)
     p.add_argument("--figure", required=True)
+    r = sub.add_parser("replot-bench")
+    r.add_argument("json", help="bench_peers.json written by `plot_peers.py bench`")
+    r.add_argument("--figure", required=True)
+    r = sub.add_parser("replot-physics")
+    r.add_argument("csv", help="physics_<N>.csv written by `plot_peers.py physics`")
+    r.add_argument("--versions", required=True, help="versions.json of the peers, or a bench_peers.json that holds them")
+    r.add_argument("--amplitude", required=True, help="the perturbation the run used (m/s)")
+    r.add_argument("--figure", required=True)
     a = ap.parse_args()
-    {"bench": cmd_bench, "observables": cmd_observables, "physics": cmd_physics}[a.cmd](a)
+    {"bench": cmd_bench, "observables": cmd_observables, "physics": cmd_physics,
+     "replot-bench": cmd_replot_bench, "replot-physics": cmd_replot_physics}[a.cmd](a)
 
 
 if __name__ == "__main__":

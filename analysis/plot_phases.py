@@ -8,8 +8,6 @@ Reads structured fields only; nothing is parsed out of labels.
 Usage: /usr/bin/python3 analysis/plot_phases.py BENCH.json --figure OUT.png --table OUT.csv [--markdown OUT.md]
 """
 import argparse
-import json
-import os
 import sys
 
 import matplotlib
@@ -18,9 +16,9 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import pandas as pd  # noqa: E402
 
-from atomic_io import atomic_write  # noqa: E402
+from atomic_io import atomic_write, write_text  # noqa: E402
+from results import PAPER_JSON, PHASES, bar_style, footer, legend_outside, load, load_paper, save_figure, wide  # noqa: E402
 
-PHASES = ["predict", "search", "forces", "correct"]
 GROUPS = PHASES + ["search_plus_forces", "total"]
 
 
@@ -29,23 +27,21 @@ def series(variant, threads, multi):
     return f"{variant} ×{threads}" if multi.get(variant, False) else variant
 
 
-def several_counts(entries):
+def several_counts(table):
     """variant -> whether the run timed it at more than one thread count."""
-    seen = {}
-    for e in entries:
-        seen.setdefault(e["variant"], set()).add(e.get("threads", 0))
-    return {v: len(t) > 1 for v, t in seen.items()}
+    return {v: t > 1 for v, t in table.groupby("variant")["threads"].nunique().items()}
 
 
-def tidy_samples(bench):
+def tidy_samples(table):
     """One row per (series, repetition, phase) with seconds per step (a series: a variant at a thread count)."""
-    multi = several_counts(bench["summary"])
-    df = pd.DataFrame(bench["samples"])
-    df["variant"] = [series(v, t, multi) for v, t in zip(df["variant"], df.get("threads", [0] * len(df)))]
-    wide = df.pivot_table(index=["variant", "repetition"], columns="phase", values="seconds_per_step").reset_index()
-    wide["search_plus_forces"] = wide["search"] + wide["forces"]
-    wide["total"] = wide[PHASES].sum(axis=1)
-    return wide.melt(id_vars=["variant", "repetition"], value_vars=GROUPS, var_name="phase", value_name="seconds_per_step")
+    multi = several_counts(table)
+    w = wide(table)
+    w["variant"] = [series(v, t, multi) for v, t in zip(w["variant"], w["threads"])]
+    w["search_plus_forces_s"] = w["search_s"] + w["forces_s"]
+    tidy = w.melt(id_vars=["variant", "repetition"], value_vars=[g + "_s" for g in GROUPS], var_name="phase",
+                  value_name="seconds_per_step")
+    tidy["phase"] = tidy["phase"].str[:-2]
+    return tidy
 
 
 def table(tidy, order):
@@ -58,41 +54,38 @@ def table(tidy, order):
     return stats.sort_values(["variant", "phase"]).reset_index(drop=True)
 
 
-def caption(bench):
-    p, s = bench["provenance"], bench["scene"]
-    dirty = " (dirty)" if p["dirty"] else ""
+def caption(res):
+    s, m = res.meta["scene"], res.meta
     return (f"{s['name']}: {s['particles']} particles, {s['search']} {s['cell_size_rmax']:g}·Rmax, "
-            f"{bench['repetitions']} interleaved repetitions × {bench['steps']} steps\n"
-            f"{p['cpu']} · {p['compiler']} {p['flags']} · commit {p['commit'][:10]}{dirty} · {p['date']}")
+            f"{m['repetitions']} interleaved repetitions × {m['steps']} steps")
 
 
-def figure(stats, order, bench, path):
+def figure(stats, order, res, path):
     phases = ["predict", "search", "forces", "correct", "total"]
     fig, ax = plt.subplots(figsize=(9, 4.8))
     width = 0.8 / max(1, len(order))
-    for k, v in enumerate(order):
-        sub = stats[stats.variant == v].set_index("phase").loc[phases]
+    for k, (name, variant, threads) in enumerate(order):
+        sub = stats[stats.variant == name].set_index("phase").loc[phases]
         x = [i + (k - (len(order) - 1) / 2) * width for i in range(len(phases))]
         err = [sub["median"] - sub["min"], sub["max"] - sub["median"]]
-        ax.bar(x, sub["median"], width, yerr=err, capsize=2, label=v)
+        ax.bar(x, sub["median"], width, yerr=err, capsize=1.5, error_kw={"elinewidth": 0.8},
+               label=name + (f" ({threads} threads)" if int(threads) > 1 and "×" not in name else ""), **bar_style(variant, threads))
     ax.set_yscale("log")
     ax.set_xticks(range(len(phases)))
     ax.set_xticklabels(phases)
     ax.set_ylabel("CPU time per step (s)")
-    ax.legend(ncol=min(4, len(order)), fontsize=8)
+    legend_outside(ax, fontsize=8)
     ax.grid(axis="y", which="both", alpha=0.3)
     ax.set_title("Per-phase CPU time per variant (median, min–max whiskers)", fontsize=10)
-    fig.text(0.01, 0.01, caption(bench), fontsize=6.5, va="bottom")
-    fig.tight_layout(rect=(0, 0.07, 1, 1))
-    atomic_write(path, lambda tmp: fig.savefig(tmp, dpi=150, format="png"))
+    save_figure(fig, path, footer(res.provenance, caption(res)))
 
 
-def markdown(stats, order, bench):
+def markdown(stats, order, res):
     """A Markdown table of µs per step (median) and the ratio to arrays, with the provenance line."""
     phases = ["predict", "search", "forces", "correct", "search_plus_forces", "total"]
     head = "| variant | " + " | ".join(p.replace("_", " ") for p in phases) + " | µs per particle-step |"
     lines = [head, "|" + "---|" * (len(phases) + 2)]
-    n = bench["scene"]["particles"]
+    n = res.meta["scene"]["particles"]
     for v in order:
         sub = stats[stats.variant == v].set_index("phase")
         cells = []
@@ -101,16 +94,15 @@ def markdown(stats, order, bench):
             ratio = sub.loc[p, "ratio_to_arrays"] if "ratio_to_arrays" in sub else float("nan")
             cells.append(f"{med:.1f} ({ratio:.2f}×)")
         lines.append(f"| {v} | " + " | ".join(cells) + f" | {sub.loc['total', 'median'] / n * 1e6:.3f} |")
-    return ("Median µs per step (ratio to arrays). " + caption(bench).replace("\n", ". ") + "\n\n" + "\n".join(lines) + "\n")
+    return (f"Median µs per step (ratio to arrays). {caption(res)}. {footer(res.provenance)}\n\n" + "\n".join(lines) + "\n")
 
 
 def paper_ratios(stats, paper_json):
     """The paper's Figure 7 ratios (its three codes) beside this run's, when f90, oop and pascal ran."""
     have = set(stats.variant.astype(str))
-    if not {"f90", "oop"} <= have or not paper_json or not os.path.exists(paper_json):
+    paper = load_paper(paper_json).get("figure7_ratios_stated")
+    if not {"f90", "oop"} <= have or not paper:
         return ""
-    with open(paper_json) as f:
-        paper = json.load(f)["figure7_ratios_stated"]
     med = stats.assign(variant=stats.variant.astype(str), phase=stats.phase.astype(str)).set_index(["variant", "phase"])["median"]
 
     def fmt(v):
@@ -134,20 +126,23 @@ def main(argv):
     ap.add_argument("--figure", required=True)
     ap.add_argument("--table", required=True)
     ap.add_argument("--markdown", help="also write the table as Markdown")
-    ap.add_argument("--paper", default=os.path.join(os.path.dirname(__file__), "..", "..", "shared", "data", "paper.json"),
-                    help="the paper's figures (default: ../shared/data/paper.json beside the project)")
+    ap.add_argument("--paper", default=PAPER_JSON, help="the paper's figures (default: data/paper.json in the repository)")
     a = ap.parse_args(argv)
-    with open(a.bench) as f:
-        bench = json.load(f)
-    multi = several_counts(bench["summary"])
-    order = [series(s["variant"], s.get("threads", 0), multi) for s in bench["summary"]]
-    stats = table(tidy_samples(bench), order)
+    res = load(a.bench)
+    stats, order = phase_stats(res)
     atomic_write(a.table, lambda tmp: stats.to_csv(tmp, index=False, float_format="%.6g"))
-    figure(stats, order, bench, a.figure)
+    figure(stats, order, res, a.figure)
     if a.markdown:
-        text = markdown(stats, order, bench) + paper_ratios(stats, a.paper)
-        atomic_write(a.markdown, lambda tmp: open(tmp, "w").write(text))
+        text = markdown(stats, [name for name, _, _ in order], res) + paper_ratios(stats, a.paper)
+        write_text(a.markdown, text)
     print(stats.to_string(index=False, float_format=lambda x: f"{x:.4g}"))
+
+
+def phase_stats(res):
+    """The per-phase table of a `demmat bench` result and its series in the run's order: (name, variant, threads)."""
+    multi = several_counts(res.table)
+    order = [(series(s["variant"], s.get("threads", 0), multi), s["variant"], s.get("threads", 0)) for s in res.meta["summary"]]
+    return table(tidy_samples(res.table), [name for name, _, _ in order]), order
 
 
 if __name__ == "__main__":

@@ -8,7 +8,6 @@ time step in units of the Hertz contact time against restitution, one panel per 
 line per integrator (colour) and precision (solid double, dashed float); and beside the JSON a Markdown
 table (the same name, .md).
 """
-import json
 import sys
 from pathlib import Path
 
@@ -16,16 +15,16 @@ import matplotlib
 
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
-import pandas as pd  # noqa: E402
+from atomic_io import write_text  # noqa: E402
+from results import footer, legend_outside, load as load_result, save_figure  # noqa: E402
 
 SCENES = {"head_on": "head-on pair", "wall": "sphere on a wall (gravity)", "dense_bed": "dense bed, 125 grains"}
 COLOURS = {"gear5": "tab:blue", "gear3": "tab:orange", "verlet": "tab:green", "symplectic_euler": "tab:red"}
 
 
 def load(path):
-    doc = json.loads(Path(path).read_text())
-    rows = pd.DataFrame(doc["rows"])
-    return doc, rows
+    res = load_result(str(path))
+    return dict(res.meta, provenance=res.provenance), res.table
 
 
 def plot(doc, rows, out):
@@ -50,15 +49,10 @@ def plot(doc, rows, out):
                 ax.set_ylabel(f"{SCENES[scene]}\nlargest stable Δt / t_c")
             if i == len(scenes) - 1:
                 ax.set_xlabel("restitution (target)")
-    handles, labels = axes[0][0].get_legend_handles_labels()
-    fig.legend(handles, labels, loc="lower center", ncol=4, fontsize=8, frameon=False)
-    prov = doc["provenance"]
+    legend_outside(axes[0][-1], fontsize=8)
     fig.suptitle(f"Stability map ({doc['mode']} run, variant {doc['variant']}): stable = no detection, contact ended, "
-                 f"restitution within 0.1\n{prov.get('cpu', '')}, {prov.get('compiler', '')}, commit "
-                 f"{str(prov.get('commit', ''))[:10]}{' (dirty)' if prov.get('dirty') else ''}", fontsize=9)
-    fig.tight_layout(rect=(0, 0.06, 1, 0.95))
-    out.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(out, dpi=120)
+                 "restitution within 0.1", fontsize=9)
+    save_figure(fig, str(out), footer(doc["provenance"], f"{doc['seconds']:.0f} s"), dpi=120, top=0.97)
     print(f"wrote {out}")
 
 
@@ -100,7 +94,7 @@ def table(doc, rows, out):
     for reason, n in kinds.value_counts().items():
         lines.append(f"| {reason or 'no failure up to 8 t_c'} | {n} |")
     lines.append("")
-    out.write_text("\n".join(lines))
+    write_text(str(out), "\n".join(lines))
     print(f"wrote {out}")
 
 

@@ -6,7 +6,6 @@ speed-up from one to two threads, and the 10⁶-particle run's time and peak mem
 Usage: /usr/bin/python3 analysis/summarise_fast.py results/fast [-o results/fast/summary.md]
 """
 import argparse
-import json
 import pathlib
 import re
 import sys
@@ -14,9 +13,10 @@ import sys
 import pandas as pd
 
 from atomic_io import write_text
+import results
 
 
-def load(folder):
+def read(folder):
     """One row per (state, N, variant, threads) from bench_settled_<N>.json and bench_loose_<N>.json
     (every thread count in one run, interleaved); also the paired speed-ups: per repetition, the 1-thread total over the t-thread total
     of the same variant, taken side by side."""
@@ -25,9 +25,10 @@ def load(folder):
         m = re.fullmatch(r"bench_(settled|loose)_(\d+)\.json", path.name)
         if not m:
             continue
-        d = json.loads(path.read_text())
+        res = results.load(str(path))
+        d = res.meta
         state, n = m.group(1), int(m.group(2))
-        prov.setdefault(state, {})[n] = d["provenance"]
+        prov.setdefault(state, {})[n] = res.provenance
         for s in d["summary"]:
             sec = s["seconds_per_step"]
             total = sec["total"]["median"]
@@ -40,8 +41,7 @@ def load(folder):
                 "contacts/particle": s["contacts_per_particle"], "bytes/particle": s["memory_bytes"] / d["scene"]["particles"],
                 "repetitions": d["repetitions"], "steps": d["steps"],
             })
-        smp = pd.DataFrame(d["samples"])
-        tot = smp.groupby(["variant", "threads", "repetition"])["seconds_per_step"].sum().unstack("threads")
+        tot = res.table.groupby(["variant", "threads", "repetition"])["seconds"].sum().unstack("threads")
         if 1 in tot.columns:
             for t in tot.columns:
                 if t != 1:
@@ -69,7 +69,7 @@ def main(argv):
     ap.add_argument("folder", type=pathlib.Path)
     ap.add_argument("-o", "--output", type=pathlib.Path)
     a = ap.parse_args(argv)
-    df, paired, prov = load(a.folder)
+    df, paired, prov = read(a.folder)
     if df.empty:
         print(f"summarise_fast.py: no bench_settled_<N>.json or bench_loose_<N>.json in {a.folder}", file=sys.stderr)
         return 1
@@ -105,7 +105,7 @@ def main(argv):
     million = a.folder / "million.json"
     mtime = a.folder / "million_time.txt"
     if million.exists() and mtime.exists():
-        m = json.loads(million.read_text())
+        m = results.load(str(million)).meta
         text = mtime.read_text()
         rss = re.search(r"Maximum resident set size \(kbytes\): (\d+)", text)
         out += ["", "## 10⁶ particles", ""]

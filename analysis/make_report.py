@@ -1,0 +1,167 @@
+#!/usr/bin/python3
+"""One report of every result present: results/REPORT.md.
+
+Machine and provenance from every result file (through results.py); Figure 7 computed from the
+`demmat bench` JSON with the paper's ratios beside; Figure 4 and the sweep, the peers, the validation
+against them, accuracy, stability and feature costs from the tables their scripts wrote. A result that
+is absent gets a line naming the script that makes it. Images are linked relative to the report.
+
+Usage: /usr/bin/python3 analysis/make_report.py [--results results] [--out results/REPORT.md] [--paper PAPER.json]
+"""
+import argparse
+import glob
+import os
+import re
+import sys
+
+from atomic_io import write_text
+from plot_phases import markdown as phases_markdown, paper_ratios, phase_stats
+from results import PAPER_JSON, load
+
+
+class Report:
+    def __init__(self, root, out):
+        self.root, self.folder, self.lines = root, os.path.dirname(os.path.abspath(out)), []
+
+    def add(self, *lines):
+        self.lines += list(lines)
+
+    def path(self, rel):
+        return os.path.join(self.root, rel)
+
+    def image(self, rel, alt):
+        """A relative link to results/<rel> when the file exists."""
+        p = self.path(rel)
+        if os.path.exists(p):
+            self.add(f"![{alt}]({os.path.relpath(p, self.folder)})", "")
+
+    def link(self, rel):
+        return f"[{rel}]({os.path.relpath(self.path(rel), self.folder)})"
+
+    def include(self, rel):
+        """A Markdown file the analysis wrote, its headings put under the report's sections."""
+        with open(self.path(rel)) as f:
+            text = f.read().strip()
+        self.add(re.sub(r"^(#+) ", lambda m: "##" + m.group(1) + " ", text, flags=re.M), "", f"(from {self.link(rel)})", "")
+
+    def missing(self, what, script):
+        self.add(f"Not present: {what}. Produce it with `{script}`.", "")
+
+
+def newest(root, pattern):
+    found = sorted(glob.glob(os.path.join(root, pattern)))
+    return os.path.relpath(found[-1], root) if found else None
+
+
+def provenance(rep):
+    """Every result file's build and machine, grouped by build."""
+    builds = {}
+    for path in sorted(glob.glob(os.path.join(rep.root, "**", "*.json"), recursive=True)):
+        try:
+            res = load(path)
+        except (ValueError, KeyError):
+            continue  # not a result file (e.g. the provenance.json plot_figures writes)
+        p = res.provenance
+        key = (str(p.get("commit", "?"))[:10] + (" (dirty)" if p.get("dirty") else ""), p.get("compiler", "?"), p.get("flags", "?"),
+               p.get("cpu", "?") + (f", {p['host_cpus']} CPUs" if p.get("host_cpus") else ""))
+        b = builds.setdefault(key, {"files": [], "dates": []})
+        b["files"].append(os.path.relpath(path, rep.root))
+        b["dates"].append(str(p.get("date", "?")))
+    rep.add("## Machine and provenance", "",
+            "Every result file under the results folder, grouped by the build that wrote it (each file carries its own provenance).", "",
+            "| commit | compiler | flags | CPU | date(s) | files |", "|---|---|---|---|---|---|")
+    for (commit, compiler, flags, cpu), b in sorted(builds.items(), key=lambda kv: min(kv[1]["dates"])):
+        dates = sorted(b["dates"])
+        span = dates[0] if dates[0] == dates[-1] else f"{dates[0]} to {dates[-1]}"
+        rep.add(f"| {commit} | {compiler} | `{flags}` | {cpu} | {span} | {', '.join(b['files'])} |")
+    rep.add("")
+
+
+def figure7(rep, paper):
+    rep.add("## Figure 7: per-phase CPU time per variant, against the paper", "")
+    files = sorted(glob.glob(rep.path("main/bench_compression_*.json")))
+    if not files:
+        rep.missing("the per-phase benchmark of every variant (results/main/bench_compression_N.json)", "scripts/run_main.sh")
+        return
+    for path in files:
+        res = load(path)
+        stats, order = phase_stats(res)
+        rep.add(phases_markdown(stats, [name for name, _, _ in order], res) + paper_ratios(stats, paper), "")
+        rep.image(f"figures/phases_compression_{res.meta['scene']['particles']}.png", "Per-phase CPU time per variant")
+
+
+def sweep(rep):
+    rep.add("## Figure 4: contact search with and without cells; the sweep", "")
+    name = next((s for s in ("full", "short") if os.path.exists(rep.path(f"sweep_{s}/figure4.md"))), None)
+    if name is None:
+        rep.missing("the sweep of Figure 4, cell sizes, scaling and where the time goes", "scripts/run_figures.sh")
+        return
+    rep.include(f"sweep_{name}/figure4.md")
+    rep.image(f"figures/figure4_{name}.png", "Figure 4")
+    more = [rel for rel in (f"sweep_{name}/cellsize.md", f"sweep_{name}/scaling.md", f"sweep_{name}/where_the_time_goes.md",
+                            "sweep_million/scaling.md", "sweep_million/where_the_time_goes.md", "fast/summary.md")
+            if os.path.exists(rep.path(rel))]
+    if more:
+        rep.add("Also: " + ", ".join(rep.link(rel) for rel in more) + ".", "")
+    for fig, alt in ((f"cellsize_{name}", "Cell-size sweep"), (f"scaling_{name}", "Scaling"), (f"where_{name}", "Where the time goes")):
+        rep.image(f"figures/{fig}.png", alt)
+
+
+def section(rep, title, tables, figures, what, script):
+    """A section from the Markdown tables a script wrote, or the line saying how to make them."""
+    rep.add(f"## {title}", "")
+    present = [t for t in tables if t and os.path.exists(rep.path(t))]
+    if not present:
+        rep.missing(what, script)
+        return
+    for t in present:
+        rep.include(t)
+    for fig, alt in figures:
+        if fig:
+            rep.image(fig, alt)
+
+
+def build(root, out, paper):
+    rep = Report(root, out)
+    rep.add("# demmat: the results", "",
+            "Generated by analysis/make_report.py from the files under the results folder; every number below comes "
+            "from a result file and carries that file's provenance.", "")
+    provenance(rep)
+    figure7(rep, paper)
+    sweep(rep)
+    physics = newest(root, "peers/physics_*.md")
+    n = physics and re.search(r"physics_(\d+)\.md", physics).group(1)
+    features = newest(root, "features/features_*.md")
+    nf = features and re.search(r"features_(\d+)\.md", features).group(1)
+    section(rep, "Beside LAMMPS and LIGGGHTS: time per step", ["peers/bench_peers.md"],
+            [("figures/peers_us_per_particle_step.png", "µs per particle-step against N")],
+            "the benchmark beside LAMMPS and LIGGGHTS", "scripts/run_peers.sh")
+    section(rep, "Validation: the physics beside LAMMPS and LIGGGHTS", [physics],
+            [(n and f"figures/peers_physics_{n}.png", "Physics cross-check")],
+            "the ensemble cross-check of the physics against LAMMPS and LIGGGHTS", "scripts/run_peers.sh")
+    section(rep, "Accuracy: error against time step and CPU time", ["accuracy/recommendation.md"],
+            [("figures/accuracy_work_precision.png", "work–precision"), ("figures/accuracy_error_vs_dt.png", "error against Δt")],
+            "the speed–accuracy study", "scripts/run_accuracy.sh")
+    section(rep, "Stability: the largest stable time step", ["stability/stability_default.md", "stability/stability_long.md"],
+            [("figures/stability_map.png", "stability map"), ("figures/stability_map_long.png", "stability map, long run")],
+            "the stability map", "scripts/run_stability.sh")
+    section(rep, "What each model feature costs", [features], [(nf and f"figures/features_{nf}.png", "feature costs")],
+            "the feature costs", "scripts/run_features.sh")
+    write_text(out, "\n".join(rep.lines).rstrip() + "\n")
+
+
+def main(argv):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--results", default="results", help="the results folder (default: results)")
+    ap.add_argument("--out", help="the report (default: REPORT.md in the results folder)")
+    ap.add_argument("--paper", default=PAPER_JSON, help="the paper's figures (default: data/paper.json in the repository)")
+    a = ap.parse_args(argv)
+    if not os.path.isdir(a.results):
+        sys.exit(f"make_report.py: no results folder {a.results}")
+    out = a.out or os.path.join(a.results, "REPORT.md")
+    build(a.results, out, a.paper)
+    print(out)
+
+
+if __name__ == "__main__":
+    main(sys.argv[1:])

@@ -1,0 +1,115 @@
+#!/usr/bin/python3
+"""The analysis loader (analysis/results.py) on a sample of each benchmark schema, and the report.
+
+The samples in tests/data/analysis/ are trimmed copies of real results: bench_sample.json of
+`demmat bench --json` (arrays and fast, two repetitions), gbench_sample.json of demmat_bench's Google
+Benchmark JSON (fast on the settled bed of 8000 at 1 and 2 threads, two STREAM kernels).
+Run by ctest (analysis.results) with /usr/bin/python3.
+"""
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+import unittest
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+ANALYSIS = os.path.join(HERE, os.pardir, "analysis")
+DATA = os.path.join(HERE, "data", "analysis")
+sys.path.insert(0, ANALYSIS)
+
+import results  # noqa: E402
+
+TIDY = ["variant", "threads", "N", "phase", "repetition", "seconds", "sample"]
+
+
+class Loader(unittest.TestCase):
+    def test_demmat_bench(self):
+        r = results.load(os.path.join(DATA, "bench_sample.json"))
+        self.assertEqual(r.kind, "bench")
+        self.assertEqual(list(r.table.columns), TIDY)
+        self.assertIs(r.provenance["dirty"], False)
+        self.assertEqual(len(r.table), 16)  # 2 variants × 2 repetitions × 4 phases
+        row = r.table[(r.table.variant == "arrays") & (r.table.repetition == 0) & (r.table.phase == "predict")]
+        self.assertEqual(row.seconds.tolist(), [1.5135653999999999e-05])
+        self.assertEqual(set(r.table.N), {2000})
+        self.assertEqual(set(r.table[r.table.variant == "fast"].threads), {2})
+        w = results.wide(r.table)
+        self.assertEqual(len(w), 4)  # one row per sample
+        a0 = w[(w.variant == "arrays") & (w.repetition == 0)].iloc[0]
+        self.assertAlmostEqual(a0.total_s, a0.predict_s + a0.search_s + a0.forces_s + a0.correct_s, delta=0)
+
+    def test_google_benchmark(self):
+        r = results.load(os.path.join(DATA, "gbench_sample.json"))
+        self.assertEqual(r.kind, "gbench")
+        self.assertTrue(set(TIDY) <= set(r.table.columns))
+        self.assertIs(r.provenance["dirty"], False)  # the context holds the string "false"
+        self.assertEqual(r.provenance["commit"][:7], "8f31195")
+        self.assertEqual(r.provenance["host_cpus"], 2)
+        t = r.table
+        row = t[(t.family == "phases") & (t.threads == 1) & (t.repetition == 0) & (t.phase == "forces")]
+        self.assertEqual(row.seconds.tolist(), [0.0003912214142956283])
+        self.assertEqual(row.N.tolist(), [8000])  # the label's particles, the label's threads (not Google Benchmark's)
+        self.assertEqual(len(t[t.family == "phases"]), 6 * 4)  # 2 thread counts × 3 repetitions × 4 phases
+        stream = t[t.family == "stream"]
+        self.assertEqual(len(stream), 4)  # untimed: one row each, no phase
+        self.assertTrue(stream.phase.isna().all())
+        w = results.wide(t)
+        self.assertEqual(len(w), 10)
+        self.assertTrue(w[w.family == "stream"].total_s.isna().all())
+
+    def test_unknown_schema(self):
+        with tempfile.NamedTemporaryFile("w", suffix=".json") as f:
+            f.write('{"something": 1}')
+            f.flush()
+            with self.assertRaises(ValueError):
+                results.load(f.name)
+
+
+class OneN(unittest.TestCase):
+    def test_no_curve_against_n_from_one_n(self):
+        """The sample has one N: scaling and where-the-time-goes are tables, and a stale figure goes."""
+        root = tempfile.mkdtemp()
+        try:
+            figs = os.path.join(root, "figures")
+            os.makedirs(figs)
+            open(os.path.join(figs, "scaling_one.png"), "w").close()  # left by other data
+            done = subprocess.run([sys.executable, os.path.join(ANALYSIS, "plot_figures.py"), os.path.join(DATA, "gbench_sample.json"),
+                                   "--out", root, "--figures", figs, "--suffix", "one"], capture_output=True, text=True, timeout=120)
+            self.assertEqual(done.returncode, 0, done.stderr)
+            self.assertEqual(os.listdir(figs), [])
+            self.assertIn("| settled | fast | 2 | 8000 |", open(os.path.join(root, "scaling.md")).read())
+            self.assertIn("| 8000 | 1 | forces |", open(os.path.join(root, "where_the_time_goes.md")).read())
+        finally:
+            shutil.rmtree(root)
+
+
+class Report(unittest.TestCase):
+    def test_sections_present_and_missing(self):
+        root = tempfile.mkdtemp()
+        try:
+            os.makedirs(os.path.join(root, "main"))
+            os.makedirs(os.path.join(root, "sweep_short"))
+            shutil.copy(os.path.join(DATA, "bench_sample.json"), os.path.join(root, "main", "bench_compression_2000.json"))
+            shutil.copy(os.path.join(DATA, "gbench_sample.json"), os.path.join(root, "sweep_short", "bench.json"))
+            out = os.path.join(root, "REPORT.md")
+            done = subprocess.run([sys.executable, os.path.join(ANALYSIS, "make_report.py"), "--results", root, "--out", out],
+                                  capture_output=True, text=True, timeout=120)
+            self.assertEqual(done.returncode, 0, done.stderr)
+            self.assertEqual(done.stdout.strip(), out)
+            text = open(out).read()
+            self.assertIn("## Machine and provenance", text)
+            self.assertIn("main/bench_compression_2000.json", text)
+            self.assertIn("sweep_short/bench.json", text)
+            self.assertIn("| arrays | 15.0 (1.00×) | 656.7 (1.00×)", text)  # Figure 7 from the bench sample: µs per step, medians of 2
+            for script in ("scripts/run_figures.sh", "scripts/run_peers.sh", "scripts/run_accuracy.sh",
+                           "scripts/run_stability.sh", "scripts/run_features.sh"):
+                self.assertIn(f"Produce it with `{script}`", text)
+            self.assertNotIn("`scripts/run_main.sh`", text)  # Figure 7 is present
+            self.assertFalse([f for f in os.listdir(root) if f.endswith(".tmp") or f.startswith("tmp")])
+        finally:
+            shutil.rmtree(root)
+
+
+if __name__ == "__main__":
+    unittest.main()
