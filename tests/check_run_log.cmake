@@ -3,12 +3,7 @@ cmake_minimum_required(VERSION 3.25)
 # last, K = 100 by default), a run that blows up keeps the rows it logged, the scene file is never
 # the log, and --vtk writes the walls beside the particles and lists them as part 1 of the .pvd.
 # (The one-line errors of bad --log / --log-every values are cases of tests/bad_input/.)
-function(run_ok)
-  execute_process(COMMAND ${DEMMAT} ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "demmat ${ARGN} failed (${rc}): ${err}")
-  endif()
-endfunction()
+include(${CMAKE_CURRENT_LIST_DIR}/cli_support.cmake)
 # The log's lines; checks the header and that every row has as many fields as it.
 function(read_log file expect_rows)
   file(STRINGS ${file} lines)
