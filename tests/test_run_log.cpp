@@ -137,6 +137,22 @@ TEST(RunLog, PairContactsCountAndTheirReactionsBalanceTheWeightOnTheFloor)
     EXPECT_NEAR(row.largest_overlap_ratio, std::max(h_pair, h_wall) / r, 1e-5 * std::max(h_pair, h_wall) / r);
 }
 
+TEST(RunLog, ABlownUpStateGivesNaNNotACrash)
+{
+    // 125 grains: the contact set is a cell list, which cannot place a non-finite position.
+    Case c(dense_bed_scene(125));
+    VariantRun run("arrays", c.setup);
+    Snapshot s = run.snapshot();
+    s.position[7].z = std::nan("");
+    const LogRow row = measure_log_row(s, c.setup);
+    EXPECT_TRUE(std::isnan(row.elastic));
+    EXPECT_TRUE(std::isnan(row.total()));
+    EXPECT_TRUE(std::isnan(row.largest_overlap_ratio));
+    ASSERT_EQ(row.wall_force.size(), 6u);
+    EXPECT_TRUE(std::isnan(row.wall_force[5].z));
+    EXPECT_TRUE(log_line(row).find("nan") != std::string::npos);
+}
+
 TEST(RunLog, TheFileHasAHeaderAndARowPerLoggedStep)
 {
     Case c(undamped_drop(0.001, 0.004));

@@ -1,6 +1,7 @@
 #include "demmat/run_log.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cerrno>
 #include <cstring>
 
@@ -27,6 +28,16 @@ LogRow measure_log_row(const Snapshot& s, const Setup& setup)
     r.kinetic_rotational = ke.rotational;
     for (std::size_t i = 0; i < s.position.size(); ++i)
         r.gravitational -= setup.mass[i] * dot(setup.scene->gravity, s.position[i]);
+    r.wall_force.assign(st.walls.size(), Vec3d{});
+    // A state that has blown up between two health checks has no contact set (a cell list cannot place
+    // a non-finite or runaway position): its row says so with NaN, and the driver's check stops the run.
+    const double far = 1e15 * setup.radius_max;
+    for (const Vec3d& x : s.position)
+        if (!(std::abs(x.x) < far && std::abs(x.y) < far && std::abs(x.z) < far)) {
+            r.elastic = r.largest_overlap_ratio = std::nan("");
+            for (Vec3d& f : r.wall_force) f = {r.elastic, r.elastic, r.elastic};
+            return r;
+        }
     r.elastic = elastic_energy(s.position, st.radius, st.walls, s.step, dt, setup.contact);
 
     // Contacts through the law itself (h > 0 exactly as the variants decide it). The full model: a
@@ -40,7 +51,6 @@ LogRow measure_log_row(const Snapshot& s, const Setup& setup)
         ++r.contacts_particle;
         r.largest_overlap_ratio = std::max(r.largest_overlap_ratio, c.overlap / std::min(st.radius[i], st.radius[j]));
     }
-    r.wall_force.assign(st.walls.size(), Vec3d{});
     for (std::size_t w = 0; w < st.walls.size(); ++w) {
         const Wall& wall = st.walls[w];
         const Vec3d p = wall.point_at(s.step, dt);

@@ -34,6 +34,8 @@ struct LogRow {
     double total() const { return kinetic_translational + kinetic_rotational + gravitational + elastic; }
 };
 
+// The row of a snapshot. A position that is not finite (or absurdly far) leaves the contacts uncounted
+// and makes elastic, the overlap ratio and the wall forces NaN.
 LogRow measure_log_row(const Snapshot& s, const Setup& setup);
 
 // "step,time,…,wall0_fx,wall0_fy,wall0_fz,…" for `walls` walls, and one row in the same order (%.17g:
