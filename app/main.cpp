@@ -454,7 +454,7 @@ int main(int argc, char** argv)
     run->add_option("--vtk", ra.vtk_dir, "Write VTK snapshots and a .pvd series (ParaView) into this folder");
     run->add_option("--vtk-every", ra.vtk_every, "Steps between VTK snapshots (0: first and last only)");
     auto* log_opt = run->add_option("--log", ra.log_file, "Write a CSV time series (energies, contacts, overlap, wall forces)");
-    run->add_option("--log-every", ra.log_every, "Steps between rows of --log (default 100)")->needs(log_opt);
+    run->add_option("--log-every", ra.log_every, fmt::format("Steps between rows of --log (default {})", kDefaultLogEvery))->needs(log_opt);
     run->add_flag("--quiet,-q", ra.quiet, "No progress on stderr");
     run->add_flag("--allow-unstable", ra.allow_unstable, "Run even with a time step above the Rayleigh time, without warning");
     run->add_option("--integrator", ra.integrator, "gear5 | gear3 | verlet | symplectic_euler (overrides the scene's [integrator])");
