@@ -19,6 +19,7 @@
 #include "demmat/io.hpp"
 #include "demmat/output.hpp"
 #include "demmat/registry.hpp"
+#include "demmat/run_log.hpp"
 #include "demmat/text.hpp"
 #include "demmat/scenes.hpp"
 #include "demmat/threads.hpp"
@@ -96,15 +97,19 @@ json scene_json(const Loaded& l)
 
 // ---- demmat run ------------------------------------------------------------------------------------
 struct RunArgs {
-    std::string scene, variant = "arrays", json_file, save_file, vtk_dir;
+    std::string scene, variant = "arrays", json_file, save_file, vtk_dir, log_file;
     std::string integrator, precision;  // override the scene's [integrator] when given
-    std::int64_t steps = 1000, vtk_every = 0;
+    std::int64_t steps = 1000, vtk_every = 0, log_every = kDefaultLogEvery;
     double time = 0.0;
     bool quiet = false, allow_unstable = false;
 };
 
 int cmd_run(const RunArgs& a)
 {
+    if (!a.log_file.empty()) {
+        check_log_every(a.log_every);
+        check_log_path(a.log_file, {a.scene});
+    }
     auto l = load(a.scene, a.allow_unstable);
     if (!a.integrator.empty()) {
         const auto s = parse_integrator(a.integrator);
@@ -123,12 +128,19 @@ int cmd_run(const RunArgs& a)
 
     std::unique_ptr<VtkSeries> vtk;
     Snapshot snap;
+    std::unique_ptr<RunLog> log;
+    if (!a.log_file.empty()) {
+        check_log_path(a.log_file, {a.scene, l->scene.state_file});
+        log = std::make_unique<RunLog>(a.log_file, l->setup, a.log_every);
+        variant->snapshot(snap);
+        log->write(snap);
+    }
     auto write_vtk = [&] {
         variant->snapshot(snap);
         vtk->write(snap, l->state.radius, driver.time());
     };
     if (!a.vtk_dir.empty()) {
-        vtk = std::make_unique<VtkSeries>(a.vtk_dir, l->scene.name);
+        vtk = std::make_unique<VtkSeries>(a.vtk_dir, l->scene.name, l->scene.domain, l->state.walls, l->scene.dt);
         write_vtk();
     }
     if (!a.quiet)
@@ -141,6 +153,10 @@ int cmd_run(const RunArgs& a)
     const bool tty = isatty(STDERR_FILENO);
     driver.run(steps, [&](std::int64_t k) {
         if (vtk && a.vtk_every > 0 && (k % a.vtk_every == 0 || k == steps)) write_vtk();
+        if (log && log->due(k, steps)) {
+            variant->snapshot(snap);
+            log->write(snap);
+        }
         if (!a.quiet && (k & 63) == 0) {
             const auto now = clock::now();
             if (now - last > std::chrono::seconds(tty ? 1 : 10)) {
@@ -437,6 +453,8 @@ int main(int argc, char** argv)
     run->add_option("--save", ra.save_file, "Save the final state (continue with particles.source = \"state\")");
     run->add_option("--vtk", ra.vtk_dir, "Write VTK snapshots and a .pvd series (ParaView) into this folder");
     run->add_option("--vtk-every", ra.vtk_every, "Steps between VTK snapshots (0: first and last only)");
+    auto* log_opt = run->add_option("--log", ra.log_file, "Write a CSV time series (energies, contacts, overlap, wall forces)");
+    run->add_option("--log-every", ra.log_every, fmt::format("Steps between rows of --log (default {})", kDefaultLogEvery))->needs(log_opt);
     run->add_flag("--quiet,-q", ra.quiet, "No progress on stderr");
     run->add_flag("--allow-unstable", ra.allow_unstable, "Run even with a time step above the Rayleigh time, without warning");
     run->add_option("--integrator", ra.integrator, "gear5 | gear3 | verlet | symplectic_euler (overrides the scene's [integrator])");

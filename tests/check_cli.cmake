@@ -1,13 +1,7 @@
 cmake_minimum_required(VERSION 3.25)
 # The command line: --help on every subcommand, list, scene, run with --json/--save/--vtk, compare's
 # exit codes.
-function(run_ok)
-  execute_process(COMMAND ${DEMMAT} ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-  if(NOT rc EQUAL 0)
-    message(FATAL_ERROR "demmat ${ARGN} failed (${rc}): ${err}")
-  endif()
-  set(OUT "${out}" PARENT_SCOPE)
-endfunction()
+include(${CMAKE_CURRENT_LIST_DIR}/cli_support.cmake)
 file(REMOVE_RECURSE ${WORK})
 file(MAKE_DIRECTORY ${WORK})
 foreach(sub IN ITEMS "" list scene run compare bench)

@@ -47,13 +47,20 @@ std::vector<std::string> Registry::names() const
     return out;
 }
 
+KineticEnergy kinetic_energy_parts(const Snapshot& s, const Setup& setup)
+{
+    KineticEnergy e;
+    for (std::size_t i = 0; i < s.position.size(); ++i) {
+        e.translational += 0.5 * setup.mass[i] * dot(s.velocity[i], s.velocity[i]);
+        e.rotational += 0.5 * setup.inertia[i] * dot(s.angular_velocity[i], s.angular_velocity[i]);
+    }
+    return e;
+}
+
 double kinetic_energy(const Snapshot& s, const Setup& setup)
 {
-    double e = 0.0;
-    for (std::size_t i = 0; i < s.position.size(); ++i)
-        e += 0.5 * setup.mass[i] * dot(s.velocity[i], s.velocity[i]) +
-             0.5 * setup.inertia[i] * dot(s.angular_velocity[i], s.angular_velocity[i]);
-    return e;
+    const KineticEnergy e = kinetic_energy_parts(s, setup);
+    return e.translational + e.rotational;
 }
 
 Driver::Driver(Variant& variant, const Setup& setup) : variant_(variant), setup_(setup), step_(setup.state->step)

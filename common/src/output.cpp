@@ -1,6 +1,8 @@
 #include "demmat/output.hpp"
 
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <ctime>
 #include <sstream>
 
@@ -46,13 +48,94 @@ void VtkSeries::write(const Snapshot& s, const std::vector<double>& radius, doub
         vector_array(o, "torque", s.torque);
         o << "      </PointData>\n    </Piece>\n  </PolyData>\n</VTKFile>\n";
     });
-    written_.emplace_back(time, file);
+    std::string walls;
+    if (!walls_.empty()) {
+        walls = fmt::format("{}_walls_{:09d}.vtp", stem_, s.step);
+        write_walls(walls, s.step);
+    }
+    written_.push_back({time, file, walls});
+    // Last, so that the series never names a file that is not yet whole.
     write_atomically(dir_ / (stem_ + ".pvd"), [&](std::ostream& o) {
         o << "<?xml version=\"1.0\"?>\n<VTKFile type=\"Collection\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <Collection>\n";
-        for (const auto& [t, f] : written_)
-            o << fmt::format("    <DataSet timestep=\"{:.9g}\" group=\"\" part=\"0\" file=\"{}\"/>\n", t, f);
+        for (const Written& w : written_) {
+            o << fmt::format("    <DataSet timestep=\"{:.9g}\" group=\"\" part=\"0\" file=\"{}\"/>\n", w.time, w.particles);
+            if (!w.walls.empty())
+                o << fmt::format("    <DataSet timestep=\"{:.9g}\" group=\"\" part=\"1\" file=\"{}\"/>\n", w.time, w.walls);
+        }
         o << "  </Collection>\n</VTKFile>\n";
     });
+}
+
+void VtkSeries::write_walls(const std::string& file, std::int64_t step) const
+{
+    // One polygon per wall that cuts the domain box, at the wall's position for this step (a moving
+    // wall's point_at, the position the variants use); the cell data name the wall by its index.
+    std::vector<Vec3d> points, normal, velocity;
+    std::vector<std::size_t> offsets, id;
+    for (std::size_t w = 0; w < walls_.size(); ++w) {
+        const Wall& wall = walls_[w];
+        const std::vector<Vec3d> poly = plane_in_box(wall.point_at(step, dt_), wall.normal, domain_);
+        if (poly.empty()) continue;
+        points.insert(points.end(), poly.begin(), poly.end());
+        offsets.push_back(points.size());
+        id.push_back(w);
+        normal.push_back(wall.normal);
+        velocity.push_back(wall.velocity);
+    }
+    write_atomically(dir_ / file, [&](std::ostream& o) {
+        o << "<?xml version=\"1.0\"?>\n<VTKFile type=\"PolyData\" version=\"0.1\" byte_order=\"LittleEndian\">\n  <PolyData>\n";
+        o << fmt::format("    <Piece NumberOfPoints=\"{}\" NumberOfPolys=\"{}\">\n", points.size(), offsets.size());
+        o << "      <Points>\n";
+        vector_array(o, "position", points);
+        o << "      </Points>\n      <Polys>\n        <DataArray type=\"Int64\" Name=\"connectivity\" format=\"ascii\">\n";
+        for (std::size_t i = 0; i < points.size(); ++i) o << "          " << i << "\n";
+        o << "        </DataArray>\n        <DataArray type=\"Int64\" Name=\"offsets\" format=\"ascii\">\n";
+        for (std::size_t k : offsets) o << "          " << k << "\n";
+        o << "        </DataArray>\n      </Polys>\n";
+        o << "      <CellData Scalars=\"wall\" Vectors=\"velocity\">\n";
+        o << "        <DataArray type=\"Int64\" Name=\"wall\" format=\"ascii\">\n";
+        for (std::size_t w : id) o << "          " << w << "\n";
+        o << "        </DataArray>\n";
+        vector_array(o, "normal", normal);
+        vector_array(o, "velocity", velocity);
+        o << "      </CellData>\n    </Piece>\n  </PolyData>\n</VTKFile>\n";
+    });
+}
+
+std::vector<Vec3d> plane_in_box(const Vec3d& point, const Vec3d& normal, const Box& box)
+{
+    // The box's corners on the plane (to a tolerance relative to the box's size, so a wall on a face of
+    // the box gives that face) and the points where its edges cross the plane strictly between corners.
+    Vec3d corner[8];
+    double side[8];
+    const Vec3d diag = box.max - box.min;
+    const double eps = 1e-12 * std::sqrt(dot(diag, diag));
+    for (int k = 0; k < 8; ++k) {
+        corner[k] = {(k & 1) ? box.max.x : box.min.x, (k & 2) ? box.max.y : box.min.y, (k & 4) ? box.max.z : box.min.z};
+        side[k] = dot(corner[k] - point, normal);
+        if (std::abs(side[k]) <= eps) side[k] = 0.0;
+    }
+    std::vector<Vec3d> out;
+    for (int k = 0; k < 8; ++k)
+        if (side[k] == 0.0) out.push_back(corner[k]);
+    for (int a = 0; a < 8; ++a)
+        for (int bit = 1; bit < 8; bit <<= 1) {
+            const int b = a | bit;  // each edge once, from the corner without the bit
+            if (b == a || side[a] == 0.0 || side[b] == 0.0 || (side[a] < 0.0) == (side[b] < 0.0)) continue;
+            out.push_back(corner[a] + (side[a] / (side[a] - side[b])) * (corner[b] - corner[a]));
+        }
+    if (out.size() < 3) return {};
+    // Ordered by angle around the normal (u, v, normal right-handed): the polygon faces into the domain.
+    Vec3d centre{};
+    for (const Vec3d& p : out) centre += p;
+    centre = centre / double(out.size());
+    const double ax = std::abs(normal.x), ay = std::abs(normal.y), az = std::abs(normal.z);
+    const Vec3d least = ax <= ay && ax <= az ? Vec3d{1, 0, 0} : (ay <= az ? Vec3d{0, 1, 0} : Vec3d{0, 0, 1});
+    const Vec3d u = cross(normal, least);
+    const Vec3d v = cross(normal, u);
+    auto angle = [&](const Vec3d& p) { return std::atan2(dot(p - centre, v), dot(p - centre, u)); };
+    std::sort(out.begin(), out.end(), [&](const Vec3d& p, const Vec3d& q) { return angle(p) < angle(q); });
+    return out;
 }
 
 nlohmann::json provenance_json()

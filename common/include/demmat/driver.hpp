@@ -57,7 +57,11 @@ private:
     bool energy_check_ = false;
 };
 
-// Kinetic energy (translational + rotational) of a snapshot, summed in id order.
+// Kinetic energy (translational + rotational) of a snapshot, summed in id order, and its two parts.
+struct KineticEnergy {
+    double translational = 0.0, rotational = 0.0;
+};
+KineticEnergy kinetic_energy_parts(const Snapshot& s, const Setup& setup);
 double kinetic_energy(const Snapshot& s, const Setup& setup);
 
 } // namespace demmat

@@ -13,18 +13,34 @@
 namespace demmat {
 
 // Writes DIR/<stem>_<step>.vtp (XML PolyData: points, radius, id, velocity, angular velocity, force,
-// torque) and rewrites DIR/<stem>.pvd listing every snapshot written so far with its time.
+// torque), with walls also DIR/<stem>_walls_<step>.vtp (each wall's plane at that step clipped to the
+// domain box, one polygon per wall, a quad for a face of the box), and rewrites DIR/<stem>.pvd listing
+// every snapshot written so far with its time: the particles as part 0, the walls as part 1.
 class VtkSeries {
 public:
-    VtkSeries(std::filesystem::path dir, std::string stem) : dir_(std::move(dir)), stem_(std::move(stem)) {}
+    VtkSeries(std::filesystem::path dir, std::string stem, Box domain = {}, std::vector<Wall> walls = {}, double dt = 0.0)
+        : dir_(std::move(dir)), stem_(std::move(stem)), domain_(domain), walls_(std::move(walls)), dt_(dt) {}
     void write(const Snapshot& s, const std::vector<double>& radius, double time);
     const std::filesystem::path& dir() const { return dir_; }
 
 private:
+    struct Written {
+        double time;
+        std::string particles, walls;  // file names; walls empty without walls
+    };
+    void write_walls(const std::string& file, std::int64_t step) const;
+
     std::filesystem::path dir_;
     std::string stem_;
-    std::vector<std::pair<double, std::string>> written_;
+    Box domain_;
+    std::vector<Wall> walls_;
+    double dt_;
+    std::vector<Written> written_;
 };
+
+// The polygon where the plane through `point` with normal `normal` cuts the box, its corners in order
+// around the normal (3 to 6 corners; empty when the plane misses the box or only touches an edge).
+std::vector<Vec3d> plane_in_box(const Vec3d& point, const Vec3d& normal, const Box& box);
 
 // {commit, dirty, compiler, flags, build_type, cpu, host, date}
 nlohmann::json provenance_json();
