@@ -3,27 +3,27 @@
 # time, from the bad-input corpus and the standard scenes as seeds. Prints executions and crashes per
 # target and exits non-zero if any target crashed; a crash input is left in build-fuzz/crashes/<target>/
 # (make it a tests/bad_input case and fix the reader). Documentation: docs/testing.md.
-# Usage: scripts/fuzz.sh [SECONDS_PER_TARGET (default 60)] [TARGET...]   (targets: scene state)
 # Needs clang++-14 and libclang-rt-14-dev (Debian); installs them if missing.
-set -euo pipefail
-cd "$(dirname "$0")/.."
-seconds=${1:-60}
-shift || true
-targets=("$@")
+# Usage: scripts/fuzz.sh [--build-dir DIR] [SECONDS_PER_TARGET] [TARGET...]
+#   SECONDS_PER_TARGET  default 60;  TARGET: scene, state (default both)
+#   --build-dir DIR     the clang build folder (default build-fuzz; not $DEMMAT_BUILD_DIR, a g++ build)
+source "$(dirname "$0")/lib.sh"
+build="build-fuzz"; seconds=60; targets=()
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --build-dir) need_value "$@"; build=$2; shift 2 ;;
+    -h|--help) usage 0 ;;
+    -*) unknown_option "$1" ;;
+    scene|state) targets+=("$1"); shift ;;
+    *) [[ ${#targets[@]} -eq 0 && $1 =~ ^[0-9]+$ ]] || { echo "$SCRIPT: unknown target '$1' (scene, state)" >&2; exit 2; }
+       seconds=$1; shift ;;
+  esac
+done
+positive_int SECONDS_PER_TARGET "$seconds"
 [[ ${#targets[@]} -eq 0 ]] && targets=(scene state)
 
-missing=()
-for p in clang-14 libclang-rt-14-dev; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [[ ${#missing[@]} -gt 0 ]]; then
-  if [[ $(id -u) -eq 0 ]]; then sudo=(); else sudo=(sudo); fi
-  "${sudo[@]}" apt-get update -qq && "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-fi
-
-build=build-fuzz
-cmake -S fuzz -B "$build" -DCMAKE_CXX_COMPILER=clang++-14 >/dev/null
-cmake --build "$build" -j "$(nproc 2>/dev/null || echo 2)" >/dev/null
+install_deps --fuzz
+cmake_build -q -S fuzz "$build" -- -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=RelWithDebInfo
 
 # Seeds (read only) and the working corpus that grows across runs (kept in the build folder).
 seeds_scene=(tests/bad_input scenes)
