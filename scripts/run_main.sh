@@ -8,13 +8,13 @@
 # (scripts/run_figures.sh) take longer and run only when asked for.
 # Usage: scripts/run_main.sh [--n N] [--steps K] [--repetitions R] [--sweep | --full] [--build-dir DIR]
 #   --n N            grains in the dense bed (default 2000)
-#   --steps K        timed steps per benchmark repetition (default 500)
+#   --steps K        timed steps per benchmark repetition (default 1000)
 #   --repetitions R  interleaved benchmark repetitions (default 5)
 #   --sweep          also the figures' short sweep (Figure 4, cell sizes, scaling, where the time goes)
 #   --full           also the full sweep instead: N up to 10^5 settled, 10^6 loose (an hour or more)
 #   --build-dir DIR  the build folder (default build, or $DEMMAT_BUILD_DIR)
 source "$(dirname "$0")/lib.sh"
-n=2000; steps=500; reps=5; sweep=none
+n=2000; steps=1000; reps=5; sweep=none
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --n) need_value "$@"; n=$2; shift 2 ;;
