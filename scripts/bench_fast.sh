@@ -27,9 +27,7 @@ while [[ $# -gt 0 ]]; do
     --settle-time) need_value "$@"; settle=$2; shift 2 ;;
     --no-million) million=0; shift ;;
     --settle-only) settle_only=1; million=0; shift ;;
-    --build-dir) need_value "$@"; BUILD_DIR=$2; shift 2 ;;
-    -h|--help) usage 0 ;;
-    *) unknown_option "$1" ;;
+    *) shared_option "$@"; shift "$SHIFT" ;;
   esac
 done
 for n in $sizes; do positive_int "--sizes" "$n"; done

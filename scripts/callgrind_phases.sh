@@ -8,9 +8,7 @@ source "$(dirname "$0")/lib.sh"
 args=()
 while [[ $# -gt 0 ]]; do
   case "$1" in
-    --build-dir) need_value "$@"; BUILD_DIR=$2; shift 2 ;;
-    -h|--help) usage 0 ;;
-    -*) unknown_option "$1" ;;
+    -*) shared_option "$@"; shift "$SHIFT" ;;
     *) args+=("$1"); shift ;;
   esac
 done

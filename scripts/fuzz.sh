@@ -8,12 +8,10 @@
 #   SECONDS_PER_TARGET  default 60;  TARGET: scene, state (default both)
 #   --build-dir DIR     the clang build folder (default build-fuzz; not $DEMMAT_BUILD_DIR, a g++ build)
 source "$(dirname "$0")/lib.sh"
-build="build-fuzz"; seconds=60; targets=()
+BUILD_DIR=build-fuzz; seconds=60; targets=()
 while [[ $# -gt 0 ]]; do
   case "$1" in
-    --build-dir) need_value "$@"; build=$2; shift 2 ;;
-    -h|--help) usage 0 ;;
-    -*) unknown_option "$1" ;;
+    -*) shared_option "$@"; shift "$SHIFT" ;;
     scene|state) targets+=("$1"); shift ;;
     *) [[ ${#targets[@]} -eq 0 && $1 =~ ^[0-9]+$ ]] || { echo "$SCRIPT: unknown target '$1' (scene, state)" >&2; exit 2; }
        seconds=$1; shift ;;
@@ -23,7 +21,7 @@ positive_int SECONDS_PER_TARGET "$seconds"
 [[ ${#targets[@]} -eq 0 ]] && targets=(scene state)
 
 install_deps --fuzz
-cmake_build -q -S fuzz "$build" -- -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=RelWithDebInfo
+cmake_build -q -S fuzz "$BUILD_DIR" -- -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=RelWithDebInfo
 
 # Seeds (read only) and the working corpus that grows across runs (kept in the build folder).
 seeds_scene=(tests/bad_input scenes)
@@ -39,15 +37,15 @@ for t in "${targets[@]}"; do
     state) seeds=("${seeds_state[@]}"); extra=(-max_len=4096) ;;
     *) echo "fuzz.sh: unknown target '$t' (scene, state)" >&2; exit 2 ;;
   esac
-  corpus=$build/corpus/$t
-  crashes=$build/crashes/$t
+  corpus=$BUILD_DIR/corpus/$t
+  crashes=$BUILD_DIR/crashes/$t
   mkdir -p "$corpus" "$crashes"
-  log=$build/fuzz_$t.log
+  log=$BUILD_DIR/fuzz_$t.log
   echo "fuzz.sh: fuzz_$t for ${seconds} s (log: $log)" >&2
   rc=0
   # -timeout: an input that takes 10 s is a hang; -rss_limit_mb: a reader that allocates 2 GB for a
   # small input is a defect too.
-  "$build/fuzz_$t" "$corpus" "${seeds[@]}" "${extra[@]}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+  "$BUILD_DIR/fuzz_$t" "$corpus" "${seeds[@]}" "${extra[@]}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
     -artifact_prefix="$crashes/" -print_final_stats=1 >"$log" 2>&1 || rc=$?
   runs=$(grep -oE 'stat::number_of_executed_units: *[0-9]+' "$log" | grep -oE '[0-9]+$' | tail -1)
   found=$(find "$crashes" -type f | wc -l)

@@ -7,6 +7,8 @@
 #   JOBS       build jobs (every core)
 #   BUILD_DIR  the build folder: $DEMMAT_BUILD_DIR, else build; every script sets it with --build-dir DIR
 # and defines
+#   shared_option "$@"            the options every script takes: --build-dir DIR (sets BUILD_DIR),
+#                                 -h/--help; anything else: unknown_option. Then `shift "$SHIFT"`.
 #   usage [STATUS]                print the script's "# Usage:" comment block (and exit STATUS if given)
 #   unknown_option OPT            one-line error naming OPT, exit 2
 #   need_value "$@"               error unless the option in $1 has a value in $2
@@ -16,7 +18,6 @@
 #                                 configure DIR (Release unless a CMAKE_BUILD_TYPE is given) and build
 #                                 only TARGETs (everything without any); -q: no build log on stdout
 #   demmat_in DIR                 the absolute path of DIR's demmat program (still right after a cd)
-# An option that every script shares has the same name everywhere: --build-dir DIR, -h/--help.
 set -euo pipefail
 SCRIPT=$(basename "$0")
 script_file=$(cd "$(dirname "$0")" && pwd)/$SCRIPT   # for usage, after the cd below
@@ -29,6 +30,16 @@ usage() {
   # The "# Usage:" line and the indented comment lines after it, from the script's own header.
   awk '/^# Usage:/ { on = 1 } on && !/^# Usage:/ && !/^#  / { exit } on { sub(/^# /, ""); print }' "$script_file"
   [[ $# -eq 0 ]] || exit "$1"
+}
+
+# shared_option "$@": the options that every script takes, --build-dir DIR and -h/--help; anything
+# else is an unknown option. Sets SHIFT to the number of arguments used: `shift "$SHIFT"`.
+shared_option() {
+  case "$1" in
+    --build-dir) need_value "$@"; BUILD_DIR=$2; SHIFT=2 ;;
+    -h|--help) usage 0 ;;
+    *) unknown_option "$1" ;;
+  esac
 }
 
 unknown_option() {

@@ -13,9 +13,7 @@ args=()
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --long) args+=(--long); shift ;;
-    --build-dir) need_value "$@"; BUILD_DIR=$2; shift 2 ;;
-    -h|--help) usage 0 ;;
-    *) unknown_option "$1" ;;
+    *) shared_option "$@"; shift "$SHIFT" ;;
   esac
 done
 install_deps

@@ -19,9 +19,7 @@ while [[ $# -gt 0 ]]; do
     --steps) need_value "$@"; steps=$2; shift 2 ;;
     --repetitions) need_value "$@"; reps=$2; shift 2 ;;
     --variants) need_value "$@"; variants=$2; shift 2 ;;
-    --build-dir) need_value "$@"; BUILD_DIR=$2; shift 2 ;;
-    -h|--help) usage 0 ;;
-    *) unknown_option "$1" ;;
+    *) shared_option "$@"; shift "$SHIFT" ;;
   esac
 done
 positive_int --n "$n"; positive_int --steps "$steps"; positive_int --repetitions "$reps"

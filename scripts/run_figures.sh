@@ -19,9 +19,7 @@ while [[ $# -gt 0 ]]; do
   case "$1" in
     --full) sweep=full; shift ;;
     --repetitions) need_value "$@"; reps=$2; shift 2 ;;
-    --build-dir) need_value "$@"; BUILD_DIR=$2; shift 2 ;;
-    -h|--help) usage 0 ;;
-    *) unknown_option "$1" ;;
+    *) shared_option "$@"; shift "$SHIFT" ;;
   esac
 done
 [[ -n "$reps" ]] || { [[ $sweep == full ]] && reps=5 || reps=3; }

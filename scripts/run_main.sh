@@ -22,9 +22,7 @@ while [[ $# -gt 0 ]]; do
     --repetitions) need_value "$@"; reps=$2; shift 2 ;;
     --sweep) sweep=short; shift ;;
     --full) sweep=full; shift ;;
-    --build-dir) need_value "$@"; BUILD_DIR=$2; shift 2 ;;
-    -h|--help) usage 0 ;;
-    *) unknown_option "$1" ;;
+    *) shared_option "$@"; shift "$SHIFT" ;;
   esac
 done
 positive_int --n "$n"; positive_int --steps "$steps"; positive_int --repetitions "$reps"

@@ -35,9 +35,7 @@ while [[ $# -gt 0 ]]; do
     --physics-only) do_bench=0; shift ;;
     --prepare-only) prepare_only=1; shift ;;
     --out) need_value "$@"; out=$2; figures=$2; shift 2 ;;
-    --build-dir) need_value "$@"; BUILD_DIR=$2; shift 2 ;;
-    -h|--help) usage 0 ;;
-    *) unknown_option "$1" ;;
+    *) shared_option "$@"; shift "$SHIFT" ;;
   esac
 done
 for n in $ns; do positive_int --n "$n"; done

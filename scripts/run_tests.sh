@@ -17,8 +17,7 @@ while [[ $# -gt 0 ]]; do
   case "$1" in
     --normal) which=normal; shift ;;
     --sanitize) which=sanitize; shift ;;
-    --build-dir) need_value "$@"; BUILD_DIR=$2; shift 2 ;;
-    -h|--help) usage 0 ;;
+    --build-dir|-h|--help) shared_option "$@"; shift "$SHIFT" ;;
     *) ctest_args+=("$1"); shift ;;
   esac
 done
