@@ -13,7 +13,7 @@
 #   unknown_option OPT            one-line error naming OPT, exit 2
 #   need_value "$@"               error unless the option in $1 has a value in $2
 #   positive_int OPT VALUE        error unless VALUE is a positive integer (checked before any long work)
-#   install_deps [--optional]     install the missing Debian packages (scripts/install_deps.sh)
+#   install_deps [--optional] [--fuzz]  install the missing Debian packages (scripts/install_deps.sh)
 #   cmake_build [-q] [-S SRC] DIR [TARGET...] [-- CMAKE_ARG...]
 #                                 configure DIR (Release unless a CMAKE_BUILD_TYPE is given) and build
 #                                 only TARGETs (everything without any); -q: no build log on stdout
