@@ -18,6 +18,7 @@
 #include "demmat/features.hpp"
 #include "demmat/io.hpp"
 #include "demmat/output.hpp"
+#include "demmat/provenance.hpp"
 #include "demmat/registry.hpp"
 #include "demmat/run_log.hpp"
 #include "demmat/text.hpp"
@@ -427,6 +428,11 @@ int main(int argc, char** argv)
     CLI::App app{"demmat: the DEMMAT discrete element benchmark suite (variants of one DEM processor for spheres)"};
     app.require_subcommand(1);
     app.set_help_all_flag("--help-all", "Help for every subcommand");
+    app.set_version_flag("--version", [] {
+        const Provenance& p = build_provenance();
+        return fmt::format("demmat {}\ncommit {}{}\ncompiler {}\nflags {}\nbuild type {}", DEMMAT_VERSION, p.commit,
+                           p.dirty ? " (dirty)" : "", p.compiler, p.flags, p.build_type);
+    });
 
     auto* list = app.add_subcommand("list", "List the registered variants, one per line, name first");
     PeerCommands peers(app);  // export-lammps, import-lammps, dump (docs/peers.md)
@@ -494,6 +500,8 @@ int main(int argc, char** argv)
     } catch (const CLI::CallForHelp& e) {
         return app.exit(e);
     } catch (const CLI::CallForAllHelp& e) {
+        return app.exit(e);
+    } catch (const CLI::CallForVersion& e) {
         return app.exit(e);
     } catch (const CLI::ParseError& e) {
         std::cerr << "demmat: error: " << e.what() << " (see demmat --help)\n";

@@ -7,32 +7,35 @@
 # Writes results/fast/bench_settled_<N>.json and bench_loose_1000000.json (+ .txt; every thread count,
 # interleaved), results/fast/million.txt and the table
 # results/fast/summary.md (analysis/summarise_fast.py).
-# Usage: scripts/bench_fast.sh [--sizes "1000 10000 100000"] [--threads "1 2"] [--repetitions R]
-#                              [--settle-time T] [--no-million] [--settle-only] [--build DIR]
-# --settle-only: settle the beds (the slow, once-only part) and stop.
 # Timed steps per repetition are 5·10^6/N (at least 20), so each sample is ~10^6–10^7 particle-steps.
-set -euo pipefail
-cd "$(dirname "$0")/.."
-sizes="1000 10000 100000"; threads="1 2"; reps=5; settle=0.4; million=1; build=build; settle_only=0
+# Usage: scripts/bench_fast.sh [--sizes "1000 10000 100000"] [--threads "1 2"] [--repetitions R]
+#                              [--settle-time T] [--no-million] [--settle-only] [--build-dir DIR]
+#   --sizes LIST     the bed sizes N (default "1000 10000 100000")
+#   --threads LIST   the thread counts, timed interleaved (default "1 2")
+#   --repetitions R  interleaved repetitions (default 5)
+#   --settle-time T  simulated seconds of settling (default 0.4)
+#   --no-million     without the loose lattice of 10^6
+#   --settle-only    settle the beds (the slow, once-only part) and stop
+#   --build-dir DIR  the build folder (default build, or $DEMMAT_BUILD_DIR)
+source "$(dirname "$0")/lib.sh"
+sizes="1000 10000 100000"; threads="1 2"; reps=5; settle=0.4; million=1; settle_only=0
 while [[ $# -gt 0 ]]; do
   case "$1" in
-    --sizes) sizes="$2"; shift 2 ;;
-    --threads) threads="$2"; shift 2 ;;
-    --repetitions) reps="$2"; shift 2 ;;
-    --settle-time) settle="$2"; shift 2 ;;
+    --sizes) need_value "$@"; sizes=$2; shift 2 ;;
+    --threads) need_value "$@"; threads=$2; shift 2 ;;
+    --repetitions) need_value "$@"; reps=$2; shift 2 ;;
+    --settle-time) need_value "$@"; settle=$2; shift 2 ;;
     --no-million) million=0; shift ;;
     --settle-only) settle_only=1; million=0; shift ;;
-    --build) build="$2"; shift 2 ;;
-    *) echo "bench_fast.sh: unknown option $1 (expected --sizes, --threads, --repetitions, --settle-time, --no-million, --settle-only, --build)" >&2; exit 2 ;;
+    *) shared_option "$@"; shift "$SHIFT" ;;
   esac
 done
+for n in $sizes; do positive_int "--sizes" "$n"; done
+positive_int --repetitions "$reps"
 
-if [[ ! -x "$build/app/demmat" ]]; then
-  scripts/install_deps.sh
-  cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release
-fi
-cmake --build "$build" -j "$(nproc 2>/dev/null || echo 2)" --target demmat
-demmat=$build/app/demmat
+install_deps
+cmake_build "$BUILD_DIR" demmat
+demmat=$(demmat_in "$BUILD_DIR")
 mkdir -p scenes/generated states results/fast
 
 for n in $sizes; do
@@ -74,5 +77,5 @@ if [[ $million == 1 ]]; then
   grep -E "Maximum resident|Elapsed" results/fast/million_time.txt | tee -a results/fast/million.txt
   cat results/fast/million.txt
 fi
-/usr/bin/python3 analysis/summarise_fast.py results/fast -o results/fast/summary.md >/dev/null
+$PYTHON analysis/summarise_fast.py results/fast -o results/fast/summary.md >/dev/null
 echo "results in results/fast/ (table: results/fast/summary.md)"

@@ -3,27 +3,25 @@
 # time, from the bad-input corpus and the standard scenes as seeds. Prints executions and crashes per
 # target and exits non-zero if any target crashed; a crash input is left in build-fuzz/crashes/<target>/
 # (make it a tests/bad_input case and fix the reader). Documentation: docs/testing.md.
-# Usage: scripts/fuzz.sh [SECONDS_PER_TARGET (default 60)] [TARGET...]   (targets: scene state)
 # Needs clang++-14 and libclang-rt-14-dev (Debian); installs them if missing.
-set -euo pipefail
-cd "$(dirname "$0")/.."
-seconds=${1:-60}
-shift || true
-targets=("$@")
+# Usage: scripts/fuzz.sh [--build-dir DIR] [SECONDS_PER_TARGET] [TARGET...]
+#   SECONDS_PER_TARGET  default 60;  TARGET: scene, state (default both)
+#   --build-dir DIR     the clang build folder (default build-fuzz; not $DEMMAT_BUILD_DIR, a g++ build)
+source "$(dirname "$0")/lib.sh"
+BUILD_DIR=build-fuzz; seconds=60; targets=()
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    -*) shared_option "$@"; shift "$SHIFT" ;;
+    scene|state) targets+=("$1"); shift ;;
+    *) [[ ${#targets[@]} -eq 0 && $1 =~ ^[0-9]+$ ]] || { echo "$SCRIPT: unknown target '$1' (scene, state)" >&2; exit 2; }
+       seconds=$1; shift ;;
+  esac
+done
+positive_int SECONDS_PER_TARGET "$seconds"
 [[ ${#targets[@]} -eq 0 ]] && targets=(scene state)
 
-missing=()
-for p in clang-14 libclang-rt-14-dev; do
-  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
-done
-if [[ ${#missing[@]} -gt 0 ]]; then
-  if [[ $(id -u) -eq 0 ]]; then sudo=(); else sudo=(sudo); fi
-  "${sudo[@]}" apt-get update -qq && "${sudo[@]}" apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
-fi
-
-build=build-fuzz
-cmake -S fuzz -B "$build" -DCMAKE_CXX_COMPILER=clang++-14 >/dev/null
-cmake --build "$build" -j "$(nproc 2>/dev/null || echo 2)" >/dev/null
+install_deps --fuzz
+cmake_build -q -S fuzz "$BUILD_DIR" -- -DCMAKE_CXX_COMPILER=clang++-14 -DCMAKE_BUILD_TYPE=RelWithDebInfo
 
 # Seeds (read only) and the working corpus that grows across runs (kept in the build folder).
 seeds_scene=(tests/bad_input scenes)
@@ -39,15 +37,15 @@ for t in "${targets[@]}"; do
     state) seeds=("${seeds_state[@]}"); extra=(-max_len=4096) ;;
     *) echo "fuzz.sh: unknown target '$t' (scene, state)" >&2; exit 2 ;;
   esac
-  corpus=$build/corpus/$t
-  crashes=$build/crashes/$t
+  corpus=$BUILD_DIR/corpus/$t
+  crashes=$BUILD_DIR/crashes/$t
   mkdir -p "$corpus" "$crashes"
-  log=$build/fuzz_$t.log
+  log=$BUILD_DIR/fuzz_$t.log
   echo "fuzz.sh: fuzz_$t for ${seconds} s (log: $log)" >&2
   rc=0
   # -timeout: an input that takes 10 s is a hang; -rss_limit_mb: a reader that allocates 2 GB for a
   # small input is a defect too.
-  "$build/fuzz_$t" "$corpus" "${seeds[@]}" "${extra[@]}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
+  "$BUILD_DIR/fuzz_$t" "$corpus" "${seeds[@]}" "${extra[@]}" -max_total_time="$seconds" -timeout=10 -rss_limit_mb=2048 \
     -artifact_prefix="$crashes/" -print_final_stats=1 >"$log" 2>&1 || rc=$?
   runs=$(grep -oE 'stat::number_of_executed_units: *[0-9]+' "$log" | grep -oE '[0-9]+$' | tail -1)
   found=$(find "$crashes" -type f | wc -l)

@@ -1,7 +1,9 @@
 #!/usr/bin/env bash
 # Installs the suite's dependencies from Debian's packages, only those that are missing.
-# Usage: scripts/install_deps.sh [--optional]   (--optional adds the peers' packages: lammps, liggghts)
-set -euo pipefail
+# Usage: scripts/install_deps.sh [--optional] [--fuzz]
+#   --optional  also the peers and the profiler: lammps, liggghts, valgrind
+#   --fuzz      also clang and its libFuzzer runtime (scripts/fuzz.sh)
+source "$(dirname "$0")/lib.sh"
 
 required=(
   build-essential cmake git pkg-config
@@ -12,9 +14,17 @@ required=(
   python3 python3-pandas python3-matplotlib
 )
 optional=(lammps liggghts valgrind)
+fuzz=(clang-14 libclang-rt-14-dev)
 
 want=("${required[@]}")
-[[ "${1:-}" == "--optional" ]] && want+=("${optional[@]}")
+for a in "$@"; do
+  case "$a" in
+    --optional) want+=("${optional[@]}") ;;
+    --fuzz) want+=("${fuzz[@]}") ;;
+    -h|--help) usage 0 ;;
+    *) unknown_option "$a" ;;
+  esac
+done
 
 missing=()
 for p in "${want[@]}"; do

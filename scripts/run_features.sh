@@ -6,35 +6,38 @@
 # and writes results/features/ (JSON with provenance, Markdown and CSV tables) and a figure in
 # results/figures/. A few minutes on two cores at the default size.
 # Usage: scripts/run_features.sh [--n N] [--steps K] [--repetitions R] [--variants a,b] [--build-dir DIR]
-set -euo pipefail
-cd "$(dirname "$0")/.."
-n=2000; steps=300; reps=7; variants=arrays,eigen_soa; build=build
+#   --n N            grains in the bed (default 2000)
+#   --steps K        timed steps per repetition (default 300)
+#   --repetitions R  interleaved repetitions (default 7)
+#   --variants a,b   the variants timed (default arrays,eigen_soa)
+#   --build-dir DIR  the build folder (default build, or $DEMMAT_BUILD_DIR)
+source "$(dirname "$0")/lib.sh"
+n=2000; steps=300; reps=7; variants=arrays,eigen_soa
 while [[ $# -gt 0 ]]; do
   case "$1" in
-    --n) n="$2"; shift 2 ;;
-    --steps) steps="$2"; shift 2 ;;
-    --repetitions) reps="$2"; shift 2 ;;
-    --variants) variants="$2"; shift 2 ;;
-    --build-dir) build="$2"; shift 2 ;;
-    *) echo "run_features.sh: unknown option $1 (expected --n, --steps, --repetitions, --variants, --build-dir)" >&2; exit 2 ;;
+    --n) need_value "$@"; n=$2; shift 2 ;;
+    --steps) need_value "$@"; steps=$2; shift 2 ;;
+    --repetitions) need_value "$@"; reps=$2; shift 2 ;;
+    --variants) need_value "$@"; variants=$2; shift 2 ;;
+    *) shared_option "$@"; shift "$SHIFT" ;;
   esac
 done
+positive_int --n "$n"; positive_int --steps "$steps"; positive_int --repetitions "$reps"
 
-scripts/install_deps.sh
-cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release
-cmake --build "$build" -j "$(nproc 2>/dev/null || echo 2)" --target demmat_bench_features
+install_deps
+cmake_build "$BUILD_DIR" demmat_bench_features
 
 mkdir -p states results/features results/figures
 json=results/features/bench_features_${n}.json
 tmp=$(mktemp results/features/.bench_features.XXXXXX)
 trap 'rm -f "$tmp"' EXIT
 echo "== timing the feature levels: $variants, $n particles, $reps interleaved repetitions of $steps steps"
-"$build"/bench/demmat_bench_features --n="$n" --steps="$steps" --variants="$variants" --states-dir=states \
+"$BUILD_DIR"/bench/demmat_bench_features --n="$n" --steps="$steps" --variants="$variants" --states-dir=states \
   --benchmark_repetitions="$reps" --benchmark_enable_random_interleaving=true \
   --benchmark_out="$tmp" --benchmark_out_format=json
 mv "$tmp" "$json"
 
 echo "== analysis"
-/usr/bin/python3 analysis/plot_features.py "$json" --figure results/figures/features_${n}.png \
+$PYTHON analysis/plot_features.py "$json" --figure results/figures/features_${n}.png \
   --markdown results/features/features_${n}.md --table results/features/features_${n}.csv
 echo "results: $json, results/features/features_${n}.md, results/figures/features_${n}.png"

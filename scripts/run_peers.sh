@@ -9,42 +9,47 @@
 #     kinetic energy and bed height while settling, the wall force while compressing; results/peers/physics_*.
 # Usage: scripts/run_peers.sh [--full] [--n "1000 2000"] [--steps K] [--repetitions R] [--variants LIST]
 #                             [--members M] [--physics-n N] [--bench-only] [--physics-only] [--prepare-only]
-#                             [--out DIR]
-#   --full  N = 1000 … 64000 (doubling), 500 steps, 5 repetitions, 8 ensemble members (the lead's run)
-#   --prepare-only  settle and export the stages of every N (the slow part, done once), then stop
-#   --out DIR  results and figures in DIR instead of results/peers and results/figures (a second,
-#              focused run beside the full one)
-set -euo pipefail
-cd "$(dirname "$0")/.."
+#                             [--out DIR] [--build-dir DIR]
+#   default          N = 1000, 2000, 4000; 200 steps; 3 repetitions; every variant; 4 ensemble members
+#   --full           N = 1000 … 64000 (doubling), 500 steps, 5 repetitions, 8 ensemble members (the lead's run)
+#   --n LIST         the sizes N of the benchmark;  --physics-n N: the size of the physics cross-check (2000)
+#   --bench-only, --physics-only   one of the two parts
+#   --prepare-only   settle and export the stages of every N (the slow part, done once), then stop
+#   --out DIR        results and figures in DIR instead of results/peers and results/figures (a second,
+#                    focused run beside the full one)
+#   --build-dir DIR  the build folder (default build, or $DEMMAT_BUILD_DIR); the peers' work files go
+#                    in DIR/peers
+source "$(dirname "$0")/lib.sh"
 ns="1000 2000 4000"; steps=200; reps=3; variants=all; members=4; phys_n=2000; warmup=20
 do_bench=1; do_phys=1; prepare_only=0; out=results/peers; figures=results/figures
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --full) ns="1000 2000 4000 8000 16000 32000 64000"; steps=500; reps=5; members=8; shift ;;
-    --n) ns="$2"; shift 2 ;;
-    --steps) steps="$2"; shift 2 ;;
-    --repetitions) reps="$2"; shift 2 ;;
-    --variants) variants="$2"; shift 2 ;;
-    --members) members="$2"; shift 2 ;;
-    --physics-n) phys_n="$2"; shift 2 ;;
+    --n) need_value "$@"; ns=$2; shift 2 ;;
+    --steps) need_value "$@"; steps=$2; shift 2 ;;
+    --repetitions) need_value "$@"; reps=$2; shift 2 ;;
+    --variants) need_value "$@"; variants=$2; shift 2 ;;
+    --members) need_value "$@"; members=$2; shift 2 ;;
+    --physics-n) need_value "$@"; phys_n=$2; shift 2 ;;
     --bench-only) do_phys=0; shift ;;
     --physics-only) do_bench=0; shift ;;
     --prepare-only) prepare_only=1; shift ;;
-    --out) out="$2"; figures="$2"; shift 2 ;;
-    *) echo "run_peers.sh: unknown option $1 (expected --full, --n, --steps, --repetitions, --variants, --members, --physics-n, --bench-only, --physics-only, --prepare-only, --out)" >&2; exit 2 ;;
+    --out) need_value "$@"; out=$2; figures=$2; shift 2 ;;
+    *) shared_option "$@"; shift "$SHIFT" ;;
   esac
 done
+for n in $ns; do positive_int --n "$n"; done
+positive_int --steps "$steps"; positive_int --repetitions "$reps"; positive_int --members "$members"
+positive_int --physics-n "$phys_n"
 
-scripts/install_deps.sh --optional
-build=${DEMMAT_BUILD_DIR:-build}   # another Release build folder may be named (shared machines)
-cmake -S . -B "$build" -DCMAKE_BUILD_TYPE=Release >/dev/null
-cmake --build "$build" --target demmat -j "$(nproc 2>/dev/null || echo 2)" >/dev/null
-demmat=$PWD/$build/app/demmat
+install_deps --optional
+cmake_build -q "$BUILD_DIR" demmat
+demmat=$(demmat_in "$BUILD_DIR")
 lmp=$(command -v lmp || true)
 liggghts=$(command -v liggghts || true)
 [[ -n "$lmp" ]] || { echo "run_peers.sh: LAMMPS (lmp) is not installed; scripts/install_deps.sh --optional installs it" >&2; exit 1; }
 export OMP_NUM_THREADS=1   # one core for every code; no mpirun
-work=$PWD/$build/peers      # scenes, states, data files and raw outputs (large, not kept in the repository)
+work=${demmat%/app/demmat}/peers  # scenes, states, data files and raw outputs (large, not kept in the repository)
 mkdir -p "$work" "$out"
 
 # Versions of the peers, for the results' provenance.
@@ -62,7 +67,7 @@ mkdir -p "$work" "$out"
 
 # The three stages for N particles: loose grid (t = 0), settled bed (0.4 s, all walls fixed) and the
 # compression stage (x_max moving in at 0.5 m/s), each exported for the peers.
-settler=arrays; $demmat list | grep -q "^fast " && settler=fast
+settler=arrays; grep -q "^fast " <<<"$($demmat list)" && settler=fast
 prepare() {
   local n=$1 d=$work/n$1
   mkdir -p "$d"
@@ -76,7 +81,7 @@ prepare() {
   if [[ ! -f $d/settled.state ]]; then
     echo "== settling the dense bed of $n particles (0.4 s simulated, once; kept in $d)"
     # fast on every core where it is built: bit-identical to arrays, so the same settled state, sooner.
-    $demmat run "$d/loose.toml" --variant "$settler" --threads "$(nproc 2>/dev/null || echo 1)" --time 0.4 --save "$d/settled.state" --quiet >/dev/null
+    $demmat run "$d/loose.toml" --variant "$settler" --threads "$JOBS" --time 0.4 --save "$d/settled.state" --quiet >/dev/null
   fi
   [[ -f $d/compression.toml ]] || $demmat scene compression --from "$d/loose.toml" --state "$d/settled.state" -o "$d/compression.toml"
   [[ -f $d/bed.toml ]] || $demmat scene compression --from "$d/loose.toml" --state "$d/settled.state" --speed 0 -o "$d/bed.toml"
@@ -124,7 +129,7 @@ if [[ $do_bench == 1 ]]; then
     done
     echo "== benchmark repetition $((r + 1))/$reps done"
   done
-  /usr/bin/python3 analysis/plot_peers.py bench --work "$work" --samples "$samples" --versions "$work/versions.json" \
+  $PYTHON analysis/plot_peers.py bench --work "$work" --samples "$samples" --versions "$work/versions.json" \
     --out "$out" --figure "$figures/peers_us_per_particle_step.png"
 fi
 
@@ -147,13 +152,13 @@ if [[ $do_phys == 1 ]]; then
          -var dumpfile "$(basename "$base").liggghts.dump" -in "$OLDPWD/peers/liggghts/in.trace" -log none -nocite > /dev/null 2>&1)
       for code in suite lammps liggghts; do
         [[ -f $base.$code.dump ]] || continue
-        /usr/bin/python3 analysis/plot_peers.py observables --dump "$base.$code.dump" --scene "$d/$stage.toml" \
+        $PYTHON analysis/plot_peers.py observables --dump "$base.$code.dump" --scene "$d/$stage.toml" \
           --code "$code" --member "$m" --stage "$stage" -o "$p/obs_${stage}_${code}_m$m.csv"
         rm -f "$base.$code.dump"   # frames are large; the observables are what is kept
       done
     done
     echo "== member $m/$members done"
   done
-  /usr/bin/python3 analysis/plot_peers.py physics --work "$p" --versions "$work/versions.json" --particles "$n" \
+  $PYTHON analysis/plot_peers.py physics --work "$p" --versions "$work/versions.json" --particles "$n" \
     --amplitude "$amplitude" --out "$out" --figure "$figures/peers_physics_${n}.png"
 fi
