@@ -160,7 +160,11 @@ def scene_params(path):
 def cmd_observables(a):
     p = scene_params(a.scene)
     rows = []
+    first = None
     for step, c in read_frames(a.dump):
+        # Steps from the stage's start: demmat dump continues the state's step count, LAMMPS restarts at 0.
+        first = step if first is None else first
+        step -= first
         r = c["radius"]
         m = p["rho"] * (4.0 / 3.0) * math.pi * r ** 3
         inertia = 0.4 * m * r * r

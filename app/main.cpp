@@ -4,7 +4,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <iostream>
+#include <limits>
 #include <map>
 
 #include <CLI/CLI.hpp>
@@ -24,6 +26,7 @@
 #include "demmat/text.hpp"
 #include "demmat/scenes.hpp"
 #include "demmat/threads.hpp"
+#include "cli_ranges.hpp"
 #include "peer_commands.hpp"
 
 namespace fs = std::filesystem;
@@ -38,11 +41,38 @@ struct Loaded {
     Setup setup;
 };
 
+// The files a scene reads (itself and its state file): an output must not overwrite one.
+std::vector<NamedPath> scene_inputs(const Scene& s)
+{
+    std::vector<NamedPath> in{{s.source, "scene file"}};
+    if (!s.state_file.empty()) in.emplace_back(s.state_file, "state file");
+    return in;
+}
+
+// --integrator/--precision: they replace the scene's [integrator] before anything depends on it (the
+// time-step check compares Δt with the chosen integrator's stability limit).
+void override_integrator(Scene& s, const std::string& integrator, const std::string& precision)
+{
+    if (!integrator.empty()) {
+        const auto k = parse_integrator(integrator);
+        if (!k) throw Error(fmt::format("unknown integrator '{}' (expected {})", integrator, integrator_names));
+        s.integrator.scheme = *k;
+    }
+    if (!precision.empty()) {
+        const auto p = parse_precision(precision);
+        if (!p) throw Error(fmt::format("unknown precision '{}' (expected {})", precision, precision_names));
+        s.integrator.precision = *p;
+    }
+}
+
 // Scene, initial state and setup, validated; the Setup points into the other two, so it lives with them.
-std::unique_ptr<Loaded> load(const std::string& file, bool allow_unstable)
+// `prepare` runs on the scene before its state is made and Δt is checked: a command's overrides of the
+// scene and the checks of its output paths, which must fail before any long work.
+std::unique_ptr<Loaded> load(const std::string& file, bool allow_unstable, const std::function<void(Scene&)>& prepare = {})
 {
     auto l = std::make_unique<Loaded>();
     l->scene = load_scene(file);
+    if (prepare) prepare(l->scene);
     l->state = initial_state(l->scene);
     if (!allow_unstable) {
         const std::string warning = check_time_step(l->scene, l->state);
@@ -52,13 +82,14 @@ std::unique_ptr<Loaded> load(const std::string& file, bool allow_unstable)
     return l;
 }
 
+// --steps (>= 1, checked by the option) or, when --time is given (> 0), the steps that reach it.
 std::int64_t steps_for(const Scene& scene, std::int64_t steps, double time)
 {
     // 2^53 steps: beyond that a step count is not exact in a double (and the conversion could overflow).
-    if (!(time >= 0.0) || !(time / scene.dt < 9007199254740992.0))
-        throw Error(fmt::format("--time {} is not a time >= 0 s that a run of Δt = {:g} s can reach", time, scene.dt));
-    if (steps < 0) throw Error(fmt::format("--steps {} is negative", steps));
-    if (time > 0.0) return std::int64_t(std::ceil(time / scene.dt - 1e-9));  // integer steps, never accumulated time
+    if (!(time >= 0.0) || !(time / scene.dt <= double(kMaxSteps)))
+        throw Error(fmt::format("--time {:g} s is more than a run of Δt = {:g} s can reach in {} steps", time, scene.dt, kMaxSteps));
+    if (steps < 1) throw Error(fmt::format("--steps {} is not a step count >= 1", steps));
+    if (time > 0.0) return std::max<std::int64_t>(1, std::int64_t(std::ceil(time / scene.dt - 1e-9)));  // integer steps, never accumulated time
     return steps;
 }
 
@@ -105,24 +136,35 @@ struct RunArgs {
     bool quiet = false, allow_unstable = false;
 };
 
+// Every output of `demmat run`, checked before the run: none is a directory or an input, each can be
+// written, and no two are the same file.
+void check_run_outputs(const RunArgs& a, const Scene& s)
+{
+    const auto inputs = scene_inputs(s);
+    if (!a.json_file.empty()) check_output_path(a.json_file, "--json", inputs);
+    if (!a.save_file.empty()) check_output_path(a.save_file, "--save", inputs);
+    if (!a.json_file.empty() && !a.save_file.empty() && same_file(a.json_file, a.save_file))
+        throw Error(fmt::format("--json and --save name the same file {}", a.json_file));
+    if (!a.vtk_dir.empty()) {
+        check_output_folder(a.vtk_dir, "--vtk");
+        const fs::path pvd = fs::path(a.vtk_dir) / (safe_file_stem(s.name) + ".pvd");
+        check_output_path(pvd, "--vtk", inputs);
+        for (const std::string* f : {&a.json_file, &a.save_file})
+            if (!f->empty() && same_file(*f, pvd)) throw Error(fmt::format("{} is also the VTK series of --vtk", *f));
+    }
+}
+
 int cmd_run(const RunArgs& a)
 {
     if (!a.log_file.empty()) {
         check_log_every(a.log_every);
         check_log_path(a.log_file, {a.scene});
     }
-    auto l = load(a.scene, a.allow_unstable);
-    if (!a.integrator.empty()) {
-        const auto s = parse_integrator(a.integrator);
-        if (!s) throw Error(fmt::format("unknown integrator '{}' (expected {})", a.integrator, integrator_names));
-        l->scene.integrator.scheme = *s;
-    }
-    if (!a.precision.empty()) {
-        const auto p = parse_precision(a.precision);
-        if (!p) throw Error(fmt::format("unknown precision '{}' (expected {})", a.precision, precision_names));
-        l->scene.integrator.precision = *p;
-    }
     const VariantInfo& info = registry().find(a.variant);
+    auto l = load(a.scene, a.allow_unstable, [&](Scene& s) {
+        override_integrator(s, a.integrator, a.precision);
+        check_run_outputs(a, s);
+    });
     const std::int64_t steps = steps_for(l->scene, a.steps, a.time);
     auto variant = info.create();
     Driver driver(*variant, l->setup);
@@ -140,8 +182,10 @@ int cmd_run(const RunArgs& a)
         variant->snapshot(snap);
         vtk->write(snap, l->state.radius, driver.time());
     };
+    // Files named after the scene's name, made safe: a name such as "../../x" stays inside the folder.
+    const std::string vtk_stem = safe_file_stem(l->scene.name);
     if (!a.vtk_dir.empty()) {
-        vtk = std::make_unique<VtkSeries>(a.vtk_dir, l->scene.name, l->scene.domain, l->state.walls, l->scene.dt);
+        vtk = std::make_unique<VtkSeries>(a.vtk_dir, vtk_stem, l->scene.domain, l->state.walls, l->scene.dt);
         write_vtk();
     }
     if (!a.quiet)
@@ -152,8 +196,8 @@ int cmd_run(const RunArgs& a)
     const auto start = clock::now();
     auto last = start;
     const bool tty = isatty(STDERR_FILENO);
-    driver.run(steps, [&](std::int64_t k) {
-        if (vtk && a.vtk_every > 0 && (k % a.vtk_every == 0 || k == steps)) write_vtk();
+    auto after_step = [&](std::int64_t k) {
+        if (vtk && ((a.vtk_every > 0 && k % a.vtk_every == 0) || k == steps)) write_vtk();  // every E, and the last
         if (log && log->due(k, steps)) {
             variant->snapshot(snap);
             log->write(snap);
@@ -168,7 +212,18 @@ int cmd_run(const RunArgs& a)
                                          el / double(k) * double(steps - k), tty ? "   " : "\n");
             }
         }
-    });
+    };
+    try {
+        driver.run(steps, after_step);
+    } catch (const InstabilityError& e) {
+        if (!vtk) throw;
+        // The series ends with the state at the failing step, so that ParaView shows the blow-up; --json
+        // and --save are not written.
+        write_vtk();
+        throw InstabilityError(fmt::format("{}; the VTK series {} ends with the state at step {}", e.what(),
+                                           (fs::path(a.vtk_dir) / (vtk_stem + ".pvd")).string(), driver.current_step()),
+                               e.step(), e.particle());
+    }
     const double wall = std::chrono::duration<double>(clock::now() - start).count();
     if (!a.quiet && tty) std::cerr << "\r" << std::string(78, ' ') << "\r";
 
@@ -191,9 +246,11 @@ int cmd_run(const RunArgs& a)
     std::cout << fmt::format("contacts per particle {:.3f} (particle-particle {}, particle-wall {})  kinetic energy {:.6e} J\n",
                              (2.0 * double(c.particle_particle) + double(c.particle_wall)) / n, c.particle_particle,
                              c.particle_wall, ke);
+    // Sampled: measured at the health checks only (every checks.interval steps and the last), not every step.
     if (l->scene.checks.interval > 0)
-        std::cout << fmt::format("largest overlap at the health checks {:.3g} of the smaller radius (bound {})\n",
-                                 driver.largest_overlap_ratio(), l->scene.checks.max_overlap_ratio);
+        std::cout << fmt::format("largest overlap at the health checks (sampled every {} steps and at the last) {:.3g} of the "
+                                 "smaller radius (bound {})\n",
+                                 l->scene.checks.interval, driver.largest_overlap_ratio(), l->scene.checks.max_overlap_ratio);
     std::cout << fmt::format("PERFORMANCE variant={} particles={} steps={} us_per_particle_step={:.5f} seconds={:.4f}\n",
                              info.name, l->state.size(), steps, t.total() * per / n * 1e6, wall);
 
@@ -219,7 +276,8 @@ int cmd_run(const RunArgs& a)
                   {"contacts", {{"particle_particle", c.particle_particle}, {"particle_wall", c.particle_wall},
                                 {"per_particle", (2.0 * double(c.particle_particle) + double(c.particle_wall)) / n}}},
                   {"kinetic_energy", ke},
-                  {"largest_overlap_ratio", driver.largest_overlap_ratio()},
+                  {"largest_overlap_ratio", driver.largest_overlap_ratio()},  // sampled at the health checks
+                  {"largest_overlap_sampled_every_steps", l->scene.checks.interval},  // 0: no checks, no sample
                   {"memory_bytes", variant->memory_bytes()}};
         write_atomically(a.json_file, j.dump(2) + "\n");
     }
@@ -232,8 +290,17 @@ int cmd_compare(const std::string& scene, const std::string& variants, std::int6
     auto l = load(scene, allow_unstable);
     // A variant may be named twice: two instances must agree too (run-to-run determinism).
     auto names = variant_list(variants, true);
-    if (variants == "all")  // every variant that promises bit identity (fast_unordered drops it on purpose)
+    if (variants == "all") {  // every variant that promises bit identity (fast_unordered drops it on purpose)
+        std::vector<std::string> left_out;
+        for (const std::string& n : names)
+            if (!registry().find(n).bitwise) left_out.push_back(n);
         std::erase_if(names, [](const std::string& n) { return !registry().find(n).bitwise; });
+        if (!left_out.empty())
+            std::cout << fmt::format("left out: {} (not bit-identical by design: {} not keep the canonical order of force "
+                                     "summation; name {} in --variants to see how far {} drift)\n",
+                                     fmt::join(left_out, ", "), left_out.size() == 1 ? "it does" : "they do",
+                                     left_out.size() == 1 ? "it" : "them", left_out.size() == 1 ? "it" : "they");
+    }
     if (variants == "all" && names.size() == 1) names.push_back(names.front());
     if (names.size() < 2) throw Error("compare needs at least two variants (a variant may be named twice)");
     const std::int64_t k = steps_for(l->scene, steps, time);
@@ -274,7 +341,9 @@ std::vector<int> thread_counts(const std::string& spec)
         } catch (const std::exception&) {
             used = 0;
         }
-        if (used != item.size() || t < 0 || t > 4096) throw Error(fmt::format("--threads: '{}' is not a thread count (0 to 4096)", item));
+        if (used != item.size() || t < 0) throw Error(fmt::format("--threads: '{}' is not a thread count (0 to {})", item, max_thread_count()));
+        if (t > max_thread_count())
+            throw Error(fmt::format("--threads: {} is out of range (0 to {}: {})", item, max_thread_count(), thread_limit_reason()));
         if (t == 0) t = fallback;
         if (t > 1 && !openmp_enabled()) throw Error(fmt::format("--threads: {} threads asked, but this build has no OpenMP", t));
         if (std::find(out.begin(), out.end(), t) != out.end()) throw Error(fmt::format("--threads: {} thread(s) named twice", t));
@@ -293,7 +362,9 @@ struct BenchConfig {
 
 int cmd_bench(const BenchArgs& a)
 {
-    auto l = load(a.scene, a.allow_unstable);
+    auto l = load(a.scene, a.allow_unstable, [&](const Scene& s) {
+        if (!a.json_file.empty()) check_output_path(a.json_file, "--json", scene_inputs(s));
+    });
     const auto names = variant_list(a.variants);
     const std::vector<int> counts_asked = thread_counts(a.threads);
     std::vector<BenchConfig> configs;
@@ -389,31 +460,42 @@ int cmd_bench(const BenchArgs& a)
 // ---- demmat scene ----------------------------------------------------------------------------------------
 struct SceneArgs {
     std::string kind, out, from, state;
-    std::int64_t count = 0;
+    std::int64_t count = 0;  // 0: the kind's default
     std::uint64_t seed = 1;
     std::int64_t max_layers = dense_bed_max_layers;
-    double speed = -1.0, gap = 0.001;
+    double speed = 0.0, gap = 0.001;  // speed 0: the kind's default
 };
 
+// Writes a scene only if `demmat run` would accept it: the options are checked by their validators (--n
+// >= 1, --speed > 0, --gap >= 0, finite), and the scene itself by making its initial state (particles in
+// the domain, apart, clear of the walls; a state file of this scene) and checking Δt as run does.
 int cmd_scene(const SceneArgs& a)
 {
+    if (!a.out.empty()) {
+        std::vector<NamedPath> inputs;
+        if (!a.from.empty()) inputs.emplace_back(a.from, "scene file");
+        if (!a.state.empty()) inputs.emplace_back(a.state, "state file");
+        check_output_path(a.out, "--out", inputs);
+    }
     Scene s;
     if (a.kind == "paper") s = paper_scene(a.count > 0 ? a.count : 1000, a.seed);
     else if (a.kind == "dense-bed") s = dense_bed_scene(a.count > 0 ? a.count : 2000, a.seed, a.max_layers);
-    else if (a.kind == "head-on") s = head_on_scene(a.speed >= 0.0 ? a.speed : 1.0);
+    else if (a.kind == "head-on") s = head_on_scene(a.speed > 0.0 ? a.speed : 1.0);
     else if (a.kind == "drop") s = drop_scene(a.gap);
     else if (a.kind == "compression") {
         if (a.from.empty() || a.state.empty()) throw Error("scene compression needs --from SCENE and --state STATE");
-        const Scene base = load_scene(a.from);
-        fs::path state = a.state;
-        if (!a.out.empty()) {  // keep the state path relative to the new scene file, so the pair can move together
-            std::error_code ec;
-            const fs::path rel = fs::relative(fs::absolute(state), fs::absolute(fs::path(a.out)).parent_path(), ec);
-            if (!ec && !rel.empty()) state = rel;
-        }
-        s = compression_scene(base, state, a.speed >= 0.0 ? a.speed : 0.5);
+        s = compression_scene(load_scene(a.from), a.state, a.speed > 0.0 ? a.speed : 0.5);
     } else {
         throw Error(fmt::format("unknown scene kind '{}' (expected paper, dense-bed, compression, head-on or drop)", a.kind));
+    }
+    {
+        const State state = initial_state(s);
+        check_time_step(s, state);  // throws above the stability limit; its warnings are run's to give
+    }
+    if (a.kind == "compression" && !a.out.empty()) {  // the state path relative to the new scene file, so the pair can move together
+        std::error_code ec;
+        const fs::path rel = fs::relative(fs::absolute(a.state), fs::absolute(fs::path(a.out)).parent_path(), ec);
+        if (!ec && !rel.empty()) s.state_file = rel;
     }
     const std::string text = scene_to_toml(s);
     if (a.out.empty()) std::cout << text;
@@ -441,11 +523,14 @@ int main(int argc, char** argv)
     auto* scene = app.add_subcommand("scene", "Write a standard scene as an editable TOML file (to stdout without --out)");
     scene->add_option("kind", sa.kind, "paper | dense-bed | compression | head-on | drop")->required();
     scene->add_option("--out,-o", sa.out, "Output file");
-    scene->add_option("--n", sa.count, "Number of particles (paper: 1000, dense-bed: 2000)");
-    scene->add_option("--seed", sa.seed, "Seed of the particle generator");
-    scene->add_option("--max-layers", sa.max_layers, "dense-bed: at most this many lattice layers; more grains make the bed wider");
-    scene->add_option("--speed", sa.speed, "head-on: relative speed (m/s); compression: wall speed (m/s)");
-    scene->add_option("--gap", sa.gap, "drop: initial gap between the sphere and the wall (m)");
+    constexpr std::int64_t int_max = 2147483647, int64_max = std::numeric_limits<std::int64_t>::max();
+    scene->add_option("--n", sa.count, "Number of particles (paper: 1000, dense-bed: 2000)")
+        ->check(integer_in(1, int_max, "32-bit particle indices"));
+    scene->add_option("--seed", sa.seed, "Seed of the particle generator")->check(integer_in(0, int64_max));
+    scene->add_option("--max-layers", sa.max_layers, "dense-bed: at most this many lattice layers; more grains make the bed wider")
+        ->check(integer_in(1, int_max));
+    scene->add_option("--speed", sa.speed, "head-on: relative speed (m/s); compression: wall speed (m/s)")->check(number_from(0.0, true));
+    scene->add_option("--gap", sa.gap, "drop: initial gap between the sphere and the wall (m)")->check(number_from(0.0, false));
     scene->add_option("--from", sa.from, "compression: the scene that was settled");
     scene->add_option("--state", sa.state, "compression: the settled state file");
 
@@ -453,12 +538,14 @@ int main(int argc, char** argv)
     auto* run = app.add_subcommand("run", "Run a scene with one variant and report per-phase times");
     run->add_option("scene", ra.scene, "Scene file (TOML)")->required();
     run->add_option("--variant,-v", ra.variant, "Variant name (see demmat list)");
-    auto* steps_opt = run->add_option("--steps,-n", ra.steps, "Number of steps");
-    run->add_option("--time,-t", ra.time, "Simulated time (s), instead of --steps")->excludes(steps_opt);
+    auto* steps_opt = run->add_option("--steps,-n", ra.steps, "Number of steps")->check(integer_in(1, kMaxSteps));
+    run->add_option("--time,-t", ra.time, "Simulated time (s), instead of --steps")->excludes(steps_opt)->check(number_from(0.0, true));
     run->add_option("--json", ra.json_file, "Write the summary as JSON with provenance");
     run->add_option("--save", ra.save_file, "Save the final state (continue with particles.source = \"state\")");
-    run->add_option("--vtk", ra.vtk_dir, "Write VTK snapshots and a .pvd series (ParaView) into this folder");
-    run->add_option("--vtk-every", ra.vtk_every, "Steps between VTK snapshots (0: first and last only)");
+    run->add_option("--vtk", ra.vtk_dir, "Write VTK snapshots (particles and walls) and a .pvd series (ParaView) into this folder, "
+                                          "named after the scene (characters other than letters, digits, '-', '_', '.' become '_'); "
+                                          "on a blow-up the series ends with the failing step");
+    run->add_option("--vtk-every", ra.vtk_every, "Steps between VTK snapshots (0: first and last only)")->check(integer_in(0, kMaxSteps));
     auto* log_opt = run->add_option("--log", ra.log_file, "Write a CSV time series (energies, contacts, overlap, wall forces)");
     run->add_option("--log-every", ra.log_every, fmt::format("Steps between rows of --log (default {})", kDefaultLogEvery))->needs(log_opt);
     run->add_flag("--quiet,-q", ra.quiet, "No progress on stderr");
@@ -468,7 +555,8 @@ int main(int argc, char** argv)
     // Threads of the OpenMP variants (fast, fast_unordered); 0 = OpenMP's default (OMP_NUM_THREADS, else all cores).
     int threads = 0;
     const char* threads_help = "Threads for the threaded variants (fast, fast_unordered); 0: OpenMP's default";
-    run->add_option("--threads", threads, threads_help)->check(CLI::NonNegativeNumber);
+    const CLI::Validator thread_range = integer_in(0, max_thread_count(), thread_limit_reason());
+    run->add_option("--threads", threads, threads_help)->check(thread_range);
 
     std::string cmp_scene, cmp_variants = "all";
     std::int64_t cmp_steps = 100;
@@ -477,18 +565,18 @@ int main(int argc, char** argv)
     auto* compare = app.add_subcommand("compare", "Run variants side by side and check that every step is bit-identical");
     compare->add_option("scene", cmp_scene, "Scene file (TOML)")->required();
     compare->add_option("--variants", cmp_variants, "Comma-separated variant names, or all");
-    auto* cmp_steps_opt = compare->add_option("--steps,-n", cmp_steps, "Number of steps");
-    compare->add_option("--time,-t", cmp_time, "Simulated time (s), instead of --steps")->excludes(cmp_steps_opt);
+    auto* cmp_steps_opt = compare->add_option("--steps,-n", cmp_steps, "Number of steps")->check(integer_in(1, kMaxSteps));
+    compare->add_option("--time,-t", cmp_time, "Simulated time (s), instead of --steps")->excludes(cmp_steps_opt)->check(number_from(0.0, true));
     compare->add_flag("--allow-unstable", cmp_allow, "Run even with a time step above the Rayleigh time, without warning");
-    compare->add_option("--threads", threads, threads_help)->check(CLI::NonNegativeNumber);
+    compare->add_option("--threads", threads, threads_help)->check(thread_range);
 
     BenchArgs ba;
     auto* bench = app.add_subcommand("bench", "Time variants per phase: interleaved repetitions, medians and spread");
     bench->add_option("scene", ba.scene, "Scene file (TOML)")->required();
     bench->add_option("--variants", ba.variants, "Comma-separated variant names, or all");
-    bench->add_option("--steps,-n", ba.steps, "Timed steps per repetition")->check(CLI::PositiveNumber);
-    bench->add_option("--repetitions,-r", ba.repetitions, "Repetitions")->check(CLI::PositiveNumber);
-    bench->add_option("--warmup", ba.warmup, "Untimed steps before each repetition")->check(CLI::NonNegativeNumber);
+    bench->add_option("--steps,-n", ba.steps, "Timed steps per repetition")->check(integer_in(1, kMaxSteps));
+    bench->add_option("--repetitions,-r", ba.repetitions, "Repetitions")->check(integer_in(1, int_max));
+    bench->add_option("--warmup", ba.warmup, "Untimed steps before each repetition")->check(integer_in(0, kMaxSteps));
     bench->add_option("--json", ba.json_file, "Write the samples and medians as JSON with provenance");
     bench->add_flag("--allow-unstable", ba.allow_unstable, "Run even with a time step above the Rayleigh time, without warning");
     bench->add_option("--threads", ba.threads,

@@ -5,6 +5,7 @@
 #include <cstring>
 #include <fstream>
 #include <iostream>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -13,6 +14,7 @@
 #include "demmat/io.hpp"
 #include "demmat/peer_io.hpp"
 #include "demmat/registry.hpp"
+#include "cli_ranges.hpp"
 
 namespace fs = std::filesystem;
 
@@ -37,9 +39,9 @@ PeerCommands::PeerCommands(CLI::App& app) : a_(std::make_unique<Args>())
     a.exp->add_option("--state", a.state, "Take the particles from this state file instead of the scene's own source");
     a.exp->add_option("--out,-o", a.out, "Data file to write (NAME.data); beside it NAME.lammps, NAME.liggghts, NAME_<wall>.stl")->required();
     a.exp->add_option("--perturb", a.perturb, "Add random velocities with components uniform in [-A, A] m/s (an ensemble member)")
-        ->check(CLI::NonNegativeNumber);
-    a.exp->add_option("--seed", a.seed, "Seed of the perturbation");
-    a.exp->add_option("--skin", a.skin, "Neighbour skin of the peers (m); default half the smallest radius")->check(CLI::NonNegativeNumber);
+        ->check(number_from(0.0, false));
+    a.exp->add_option("--seed", a.seed, "Seed of the perturbation")->check(integer_in(0, std::numeric_limits<std::int64_t>::max()));
+    a.exp->add_option("--skin", a.skin, "Neighbour skin of the peers (m); default half the smallest radius")->check(number_from(0.0, false));
 
     a.imp = app.add_subcommand("import-lammps", "Read a LAMMPS data file or dump (last frame) into a state file for a scene");
     a.imp->add_option("file", a.state, "LAMMPS data file or text dump")->required();
@@ -50,8 +52,9 @@ PeerCommands::PeerCommands(CLI::App& app) : a_(std::make_unique<Args>())
     a.dump->add_option("scene", a.scene, "Scene file (TOML)")->required();
     a.dump->add_option("--state", a.state, "Start from this state file instead of the scene's own source");
     a.dump->add_option("--variant,-v", a.variant, "Variant name (see demmat list)");
-    a.dump->add_option("--steps,-n", a.steps, "Number of steps")->check(CLI::PositiveNumber);
-    a.dump->add_option("--every", a.every, "Steps between frames (the first frame is the initial state)")->check(CLI::PositiveNumber);
+    a.dump->add_option("--steps,-n", a.steps, "Number of steps")->check(integer_in(1, kMaxSteps));
+    a.dump->add_option("--every", a.every, "Steps between frames (the first frame is the initial state; frames carry the "
+                                           "scene's step, continued from a state file's)")->check(integer_in(1, kMaxSteps));
     a.dump->add_option("--out,-o", a.out, "Dump file to write")->required();
 }
 
@@ -59,26 +62,38 @@ PeerCommands::~PeerCommands() = default;
 
 namespace {
 
-// The scene's initial state, or the scene continued from another state file (its walls as a run from
-// that state would have them).
-State scene_state(Scene& scene, const std::string& state_file)
+// The scene continued from another state file, when one is given (its walls as a run from that state
+// would have them).
+void use_state_file(Scene& scene, const std::string& state_file)
 {
-    if (!state_file.empty()) {
-        scene.grid.reset();
-        scene.particles.clear();
-        scene.state_file = state_file;
-    }
-    return initial_state(scene);
+    if (state_file.empty()) return;
+    scene.grid.reset();
+    scene.particles.clear();
+    scene.state_file = state_file;
+}
+
+// The files a command reads, which its outputs must not overwrite.
+std::vector<NamedPath> inputs_of(const Scene& scene, const std::string& other = {}, const std::string& other_kind = {})
+{
+    std::vector<NamedPath> in{{scene.source, "scene file"}};
+    if (!scene.state_file.empty()) in.emplace_back(scene.state_file, "state file");
+    if (!other.empty()) in.emplace_back(other, other_kind);
+    return in;
 }
 
 int cmd_export(const std::string& scene_file, const std::string& state_file, const std::string& out,
                double perturb, std::uint64_t seed, double skin)
 {
     Scene scene = load_scene(scene_file);
-    State state = scene_state(scene, state_file);
-    if (perturb > 0.0) perturb_velocities(state, perturb, seed);
+    use_state_file(scene, state_file);
     const fs::path data = out;
     if (data.filename().empty()) throw Error(fmt::format("export: '{}' is not a file name", out));
+    const auto inputs = inputs_of(scene);
+    for (const char* ext : {".data", ".lammps", ".liggghts"})
+        check_output_path(data.parent_path() / (data.stem().string() + ext), "--out", inputs);
+    check_output_path(data, "--out", inputs);
+    State state = initial_state(scene);
+    if (perturb > 0.0) perturb_velocities(state, perturb, seed);
     PeerOptions o;
     o.data_name = data.filename().string();
     o.mesh_prefix = data.stem().string();
@@ -97,6 +112,7 @@ int cmd_export(const std::string& scene_file, const std::string& state_file, con
 int cmd_import(const std::string& file, const std::string& scene_file, const std::string& out)
 {
     const Scene scene = load_scene(scene_file);
+    check_output_path(out, "--out", inputs_of(scene, file, "LAMMPS file"));
     const State s = import_peer_state(file, scene);
     save_state(s, out);
     return 0;
@@ -105,13 +121,20 @@ int cmd_import(const std::string& file, const std::string& scene_file, const std
 int cmd_dump(const std::string& scene_file, const std::string& state_file, const std::string& variant_name, std::int64_t steps, std::int64_t every, const std::string& out)
 {
     Scene scene = load_scene(scene_file);
-    const State state = scene_state(scene, state_file);
+    use_state_file(scene, state_file);
+    check_output_path(out, "--out", inputs_of(scene));
+    check_output_path(out + ".part", "--out", inputs_of(scene));
+    const State state = initial_state(scene);
     const Setup setup = Setup::make(scene, state);
     auto variant = registry().find(variant_name).create();
     Driver driver(*variant, setup);
     // Frames go to a temporary file beside the target, renamed at the end: complete or absent.
     const fs::path target = out;
     const fs::path tmp = target.string() + ".part";
+    if (target.has_parent_path()) {
+        std::error_code ec;
+        fs::create_directories(target.parent_path(), ec);  // as write_atomically does for every other output
+    }
     {
         std::ofstream f(tmp);
         if (!f) throw Error(fmt::format("{}: cannot write: {}", tmp.string(), std::strerror(errno)));
@@ -120,9 +143,10 @@ int cmd_dump(const std::string& scene_file, const std::string& state_file, const
             variant->snapshot(snap);
             f << lammps_dump_frame(k, scene, state.radius, snap.position, snap.velocity, snap.angular_velocity);
         };
-        frame(0);
+        // Frames carry the scene's step: a run from a state file at step S writes S, S + every, ...
+        frame(state.step);
         try {
-            driver.run(steps, [&](std::int64_t k) { if (k % every == 0) frame(k); });
+            driver.run(steps, [&](std::int64_t k) { if (k % every == 0) frame(driver.current_step()); });
         } catch (...) {
             f.close();
             fs::remove(tmp);

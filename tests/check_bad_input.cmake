@@ -1,11 +1,12 @@
 cmake_minimum_required(VERSION 3.25)
 # Runs demmat on one bad input and checks: non-zero exit, one line on stderr containing the expected
 # text (the file's "# expect: " line), and no output file left behind.
-# Optional "# args: ..." line: demmat arguments, with %INPUT% and %WORK% substituted
-# (default: run %INPUT% --steps 10 --json %WORK%/out.json --save %WORK%/out.state -q).
+# Optional "# args: ..." line: demmat arguments, with %INPUT%, %WORK% and %DIR% (the corpus folder, for
+# its data/ files) substituted (default: run %INPUT% --steps 10 --json %WORK%/out.json --save %WORK%/out.state -q).
 # Optional "# damage: OPERATION ARGS" line (a damaged state file, made here rather than committed):
 # data/state_base.toml is run for 3 steps and its state saved, tests/state_damage.cpp (DAMAGE) applies
-# the operation to a copy, and the case runs on a copy of itself whose "%STATE%" names that copy.
+# the operation to a copy, and the case runs on a copy of itself whose "%STATE%" names that copy (a case
+# that must not overwrite its inputs uses "set step 3", which changes nothing, to run on copies).
 # A sanitizer report (ASan, UBSan, LSan) fails the case whatever the exit status.
 file(READ ${INPUT} text)
 string(REGEX MATCH "# expect: ([^\n]*)" _ "${text}")
@@ -14,6 +15,7 @@ if(expect STREQUAL "")
   message(FATAL_ERROR "${INPUT} has no '# expect: ' line")
 endif()
 get_filename_component(name ${INPUT} NAME_WE)
+get_filename_component(corpus ${INPUT} DIRECTORY)
 set(work ${WORK}/${name})
 file(REMOVE_RECURSE ${work} ${work}.in)
 file(MAKE_DIRECTORY ${work})
@@ -42,6 +44,7 @@ if(CMAKE_MATCH_1)
 endif()
 string(REPLACE "%INPUT%" "${INPUT}" args "${args}")
 string(REPLACE "%WORK%" "${work}" args "${args}")
+string(REPLACE "%DIR%" "${corpus}" args "${args}")
 separate_arguments(args UNIX_COMMAND "${args}")
 execute_process(COMMAND ${DEMMAT} ${args} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 20)
 string(STRIP "${err}" err)

@@ -46,3 +46,95 @@ execute_process(COMMAND ${DEMMAT} compare ${WORK}/comp.toml --variants arrays --
 if(rc EQUAL 0)
   message(FATAL_ERROR "compare with one variant must fail")
 endif()
+
+# ---- Rough edges a new user found (each check fails without its fix) ----
+function(expect_in text what)
+  string(FIND "${text}" "${what}" pos)
+  if(pos EQUAL -1)
+    message(FATAL_ERROR "expected '${what}' in: ${text}")
+  endif()
+endfunction()
+
+# The last snapshot with the default --vtk-every 0 ("first and last").
+run_ok(run ${WORK}/bed.toml --steps 30 --vtk ${WORK}/vtk0 -q)
+foreach(f dense_bed_300_000000000.vtp dense_bed_300_000000030.vtp)
+  if(NOT EXISTS ${WORK}/vtk0/${f})
+    message(FATAL_ERROR "--vtk with the default --vtk-every 0 did not write ${f}")
+  endif()
+endforeach()
+
+# The largest overlap is sampled at the health checks: the text and the JSON say at what interval.
+run_ok(run ${WORK}/bed.toml --steps 30 --json ${WORK}/overlap.json -q)
+expect_in("${OUT}" "largest overlap at the health checks (sampled every 100 steps and at the last)")
+file(READ ${WORK}/overlap.json json)
+string(JSON every GET "${json}" largest_overlap_sampled_every_steps)
+if(NOT every EQUAL 100)
+  message(FATAL_ERROR "run.json: largest_overlap_sampled_every_steps is ${every}, the scene checks every 100 steps")
+endif()
+
+# compare --variants all names the variants it leaves out.
+run_ok(compare ${WORK}/comp.toml --variants all --steps 3)
+expect_in("${OUT}" "left out: fast_unordered (not bit-identical by design")
+
+# A scene's name is no path: "../../evil" with --vtk stays inside the folder given.
+file(READ ${WORK}/bed.toml text)
+string(REGEX REPLACE "name = \"[^\"]*\"" "name = \"../../evil\"" text "${text}")
+file(WRITE ${WORK}/evil.toml "${text}")
+run_ok(run ${WORK}/evil.toml --steps 2 --vtk ${WORK}/deep/a/vtk -q)
+file(GLOB_RECURSE written RELATIVE ${WORK}/deep ${WORK}/deep/*)
+foreach(f IN LISTS written)
+  if(NOT f MATCHES "^a/vtk/[^/]+$")
+    message(FATAL_ERROR "a scene named ../../evil wrote ${WORK}/deep/${f}, outside the --vtk folder")
+  endif()
+endforeach()
+if(NOT EXISTS ${WORK}/deep/a/vtk/_._.._evil.pvd)
+  message(FATAL_ERROR "no sanitised series _._.._evil.pvd in the --vtk folder: ${written}")
+endif()
+
+# A blow-up: exit 3, the VTK series ends with the failing step, and neither --json nor --save is written.
+# A head-on pair at 100 m/s with checks every step: the overlap passes the bound within a few steps.
+run_ok(scene head-on --speed 100 -o ${WORK}/blowup.toml)
+file(READ ${WORK}/blowup.toml text)
+string(REPLACE "interval = 100" "interval = 1" text "${text}")
+file(WRITE ${WORK}/blowup.toml "${text}")
+execute_process(COMMAND ${DEMMAT} run ${WORK}/blowup.toml --steps 1000 --vtk ${WORK}/blowup --vtk-every 1000
+                        --json ${WORK}/blowup.json --save ${WORK}/blowup.state -q
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 3 OR NOT err MATCHES "ends with the state at step ([0-9]+)")
+  message(FATAL_ERROR "a blow-up: expected exit 3 and 'ends with the state at step N', got ${rc}: ${err}")
+endif()
+set(failing ${CMAKE_MATCH_1})
+string(REGEX MATCH "^demmat: run stopped: step ${failing}:" _ "${err}")
+if(NOT _)
+  message(FATAL_ERROR "the series' last step ${failing} is not the step the run stopped at: ${err}")
+endif()
+execute_process(COMMAND printf "%09d" ${failing} OUTPUT_VARIABLE padded)
+file(READ ${WORK}/blowup/head_on.pvd pvd)
+expect_in("${pvd}" "head_on_${padded}.vtp\"/>\n  </Collection>")
+if(NOT EXISTS ${WORK}/blowup/head_on_${padded}.vtp OR EXISTS ${WORK}/blowup.json OR EXISTS ${WORK}/blowup.state)
+  message(FATAL_ERROR "a blow-up: the last snapshot is missing, or --json/--save were written")
+endif()
+
+# dump and import-lammps continue the step count of the state they start from (bed.state: step 50).
+run_ok(export-lammps ${WORK}/comp.toml -o ${WORK}/peer/comp.data)
+run_ok(import-lammps ${WORK}/peer/comp.data --scene ${WORK}/comp.toml -o ${WORK}/peer/imported.state)
+run_ok(dump ${WORK}/comp.toml --state ${WORK}/peer/imported.state --steps 4 --every 2 -o ${WORK}/peer/run.dump)
+file(STRINGS ${WORK}/peer/run.dump steps REGEX "^[0-9]+$")
+file(STRINGS ${WORK}/peer/run.dump heads REGEX "^ITEM: TIMESTEP")
+list(LENGTH heads frames)
+if(NOT frames EQUAL 3)
+  message(FATAL_ERROR "dump --steps 4 --every 2: ${frames} frames, expected 3")
+endif()
+file(READ ${WORK}/peer/run.dump dump)
+string(REGEX MATCHALL "ITEM: TIMESTEP\n[0-9]+" stamps "${dump}")
+if(NOT stamps STREQUAL "ITEM: TIMESTEP\n50;ITEM: TIMESTEP\n52;ITEM: TIMESTEP\n54")
+  message(FATAL_ERROR "dump from a state at step 50 (exported, imported): frames at ${stamps}, expected 50, 52, 54")
+endif()
+# The last frame of that dump, imported, is at step 54: a dump from it starts there.
+run_ok(import-lammps ${WORK}/peer/run.dump --scene ${WORK}/comp.toml -o ${WORK}/peer/from_dump.state)
+run_ok(dump ${WORK}/comp.toml --state ${WORK}/peer/from_dump.state --steps 1 --every 1 -o ${WORK}/peer/again.dump)
+file(READ ${WORK}/peer/again.dump dump)
+string(REGEX MATCH "ITEM: TIMESTEP\n[0-9]+" first "${dump}")
+if(NOT first STREQUAL "ITEM: TIMESTEP\n54")
+  message(FATAL_ERROR "import-lammps of a dump whose last frame is step 54, dumped again: first frame ${first}")
+endif()

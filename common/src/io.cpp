@@ -7,6 +7,7 @@
 
 #include <fcntl.h>
 #include <fmt/format.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include "demmat/error.hpp"
@@ -89,6 +90,106 @@ void write_atomically(const std::filesystem::path& file, const std::function<voi
 void write_atomically(const std::filesystem::path& file, const std::string& content)
 {
     write_atomically(file, [&](std::ostream& out) { out << content; });
+}
+
+std::string read_input_file(const std::filesystem::path& file, const std::string& what, std::uintmax_t max_bytes)
+{
+    const std::string label = file.string();
+    const int fd = ::open(file.c_str(), O_RDONLY | O_CLOEXEC);
+    if (fd < 0) throw Error(fmt::format("{}: cannot open {}: {}", label, what, std::strerror(errno)));
+    struct FdCloser {
+        int fd;
+        ~FdCloser() { ::close(fd); }
+    } closer{fd};
+    struct stat st {};
+    if (::fstat(fd, &st) != 0) throw Error(fmt::format("{}: cannot open {}: {}", label, what, std::strerror(errno)));
+    if (!S_ISREG(st.st_mode)) {
+        const char* kind = S_ISDIR(st.st_mode) ? "a directory" : S_ISCHR(st.st_mode) || S_ISBLK(st.st_mode) ? "a device"
+                         : S_ISFIFO(st.st_mode) ? "a pipe" : S_ISSOCK(st.st_mode) ? "a socket" : "not a plain file";
+        throw Error(fmt::format("{}: cannot read it as a {}: it is {}, not a regular file", label, what, kind));
+    }
+    if (std::uintmax_t(st.st_size) > max_bytes)
+        throw Error(fmt::format("{}: the {} is {} bytes, more than the {} bytes a {} may have", label, what,
+                                std::uintmax_t(st.st_size), max_bytes, what));
+    // Read up to the size announced, and one byte past the cap at most (a file that grows while read).
+    std::string bytes;
+    bytes.reserve(std::size_t(st.st_size));
+    char buf[1 << 16];
+    for (;;) {
+        const ssize_t got = ::read(fd, buf, sizeof buf);
+        if (got < 0) {
+            if (errno == EINTR) continue;
+            throw Error(fmt::format("{}: cannot read {}: {}", label, what, std::strerror(errno)));
+        }
+        if (got == 0) break;
+        bytes.append(buf, std::size_t(got));
+        if (bytes.size() > max_bytes)
+            throw Error(fmt::format("{}: the {} grew past the {} bytes a {} may have while it was read", label, what, max_bytes, what));
+    }
+    return bytes;
+}
+
+bool same_file(const std::filesystem::path& a, const std::filesystem::path& b)
+{
+    namespace fs = std::filesystem;
+    std::error_code ea, eb;
+    if (fs::exists(a, ea) && fs::exists(b, eb)) {
+        std::error_code ec;
+        const bool same = fs::equivalent(a, b, ec);
+        if (!ec) return same;
+    }
+    std::error_code ca, cb;
+    const fs::path pa = fs::weakly_canonical(fs::absolute(a), ca), pb = fs::weakly_canonical(fs::absolute(b), cb);
+    return !ca && !cb && pa == pb;
+}
+
+namespace {
+// The nearest folder above `p` that exists (p's own parent, else "."'s ancestors): it must be a directory
+// this process may write into.
+void check_writable_ancestor(const std::filesystem::path& p, const std::string& option, const std::filesystem::path& shown)
+{
+    namespace fs = std::filesystem;
+    fs::path dir = fs::absolute(p).parent_path();
+    std::error_code ec;
+    while (!dir.empty() && !fs::exists(dir, ec) && dir != dir.root_path()) dir = dir.parent_path();
+    if (!fs::is_directory(dir, ec))
+        throw Error(fmt::format("{} {}: {} is not a directory", option, shown.string(), dir.string()));
+    if (::access(dir.c_str(), W_OK | X_OK) != 0)
+        throw Error(fmt::format("{} {}: cannot write into {}: {}", option, shown.string(), dir.string(), std::strerror(errno)));
+}
+} // namespace
+
+void check_output_path(const std::filesystem::path& file, const std::string& option, const std::vector<NamedPath>& inputs)
+{
+    namespace fs = std::filesystem;
+    if (file.empty()) throw Error(fmt::format("{}: an empty file name", option));
+    std::error_code ec;
+    if (fs::is_directory(file, ec)) throw Error(fmt::format("{} {}: is a directory, not a file", option, file.string()));
+    for (const auto& [input, what] : inputs)
+        if (!input.empty() && same_file(file, input))
+            throw Error(fmt::format("{} {}: is the input {} {}; refusing to overwrite it", option, file.string(), what, input.string()));
+    check_writable_ancestor(file, option, file);
+}
+
+void check_output_folder(const std::filesystem::path& dir, const std::string& option)
+{
+    namespace fs = std::filesystem;
+    if (dir.empty()) throw Error(fmt::format("{}: an empty folder name", option));
+    std::error_code ec;
+    if (fs::exists(dir, ec) && !fs::is_directory(dir, ec))
+        throw Error(fmt::format("{} {}: exists and is not a directory", option, dir.string()));
+    check_writable_ancestor(dir / "x", option, dir);
+}
+
+std::string safe_file_stem(const std::string& text)
+{
+    std::string out;
+    for (const unsigned char c : text) {
+        if (out.size() == 200) break;
+        const bool keep = (c >= 'a' && c <= 'z') || (c >= 'A' && c <= 'Z') || (c >= '0' && c <= '9') || c == '-' || c == '_' || c == '.';
+        out += keep && !(c == '.' && out.empty()) ? char(c) : '_';
+    }
+    return out.empty() ? "unnamed" : out;
 }
 
 } // namespace demmat

@@ -1,14 +1,17 @@
 #include "demmat/peer_io.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <map>
+#include <regex>
 #include <sstream>
 
 #include <fmt/format.h>
 
 #include "demmat/error.hpp"
+#include "demmat/io.hpp"
 #include "demmat/reference.hpp"
 
 namespace demmat {
@@ -205,7 +208,7 @@ std::string liggghts_fragment(const Scene& scene, const State& s, const PeerOpti
                                d17(component(w.point_at(s.step, scene.dt), a)), keywords);
             continue;
         }
-        const std::string stl = fmt::format("{}_{}.stl", o.mesh_prefix, w.name);
+        const std::string stl = fmt::format("{}_{}.stl", o.mesh_prefix, safe_file_stem(w.name));  // a name from the scene stays a file name
         meshes.emplace_back(stl, wall_stl(scene, s, w, a));
         out += fmt::format("fix demmat_mesh_{} all mesh/surface file {} type 2\n", w.name, stl);
         out += fmt::format("fix wall_{} all wall/gran {} mesh n_meshes 1 meshes demmat_mesh_{} {}\n", w.name, model, w.name, keywords);
@@ -265,10 +268,12 @@ void perturb_velocities(State& state, double amplitude, std::uint64_t seed)
 State import_peer_state(const std::filesystem::path& file, const Scene& scene)
 {
     const std::string label = file.string();
-    std::ifstream in(file);
-    if (!in) throw Error(fmt::format("{}: cannot open", label));
     std::vector<std::string> lines;
-    for (std::string l; std::getline(in, l);) lines.push_back(l);
+    {
+        // A regular file of at most 64 GiB (a text dump of 10^8 atoms with 11 columns of 17 digits is ~20 GB).
+        std::istringstream in(read_input_file(file, "LAMMPS file", std::uintmax_t(64) << 30));
+        for (std::string l; std::getline(in, l);) lines.push_back(l);
+    }
     auto trim = [](std::string s) {
         const auto c = s.find('#');
         if (c != std::string::npos) s.erase(c);
@@ -305,6 +310,16 @@ State import_peer_state(const std::filesystem::path& file, const Scene& scene)
         x.assign(n, {}); v.assign(n, {}); w.assign(n, {}); seen.assign(n, 0);
     };
 
+    // The step the particles belong to: a dump frame's TIMESTEP, or the step export-lammps names in a data
+    // file's title ("... at step S, ..."); 0 for another code's data file.
+    std::int64_t step = 0;
+    auto step_of = [&](const std::string& text, std::size_t k) {
+        std::int64_t v = -1;
+        const std::string t = trim(text);
+        const auto [end, ec] = std::from_chars(t.data(), t.data() + t.size(), v);
+        if (ec != std::errc() || end != t.data() + t.size() || v < 0) bad(label, k + 1, fmt::format("'{}' is not a step number", t));
+        return v;
+    };
     const bool dump = !lines.empty() && trim(lines[0]) == "ITEM: TIMESTEP";
     if (dump) {
         // Frames: the last complete one wins.
@@ -313,6 +328,8 @@ State import_peer_state(const std::filesystem::path& file, const Scene& scene)
         while (k < lines.size()) {
             if (trim(lines[k]).empty()) { ++k; continue; }
             if (trim(lines[k]) != "ITEM: TIMESTEP") bad(label, k + 1, "expected ITEM: TIMESTEP");
+            if (k + 1 >= lines.size()) bad(label, k + 1, "the dump frame is truncated");
+            step = step_of(lines[k + 1], k + 1);
             k += 2;
             if (k >= lines.size() || trim(lines[k]) != "ITEM: NUMBER OF ATOMS") bad(label, k + 1, "expected ITEM: NUMBER OF ATOMS");
             const double count = numbers(k + 1, 1)[0];
@@ -350,6 +367,9 @@ State import_peer_state(const std::filesystem::path& file, const Scene& scene)
         }
         if (!any) bad(label, 1, "the dump has no frame");
     } else {
+        static const std::regex title(R"(^LAMMPS data file from demmat export-lammps: .* at step ([0-9]+), [0-9]+ particles,)");
+        std::smatch m;
+        if (!lines.empty() && std::regex_search(lines[0], m, title)) step = step_of(m[1].str(), 0);
         std::size_t k = 1;  // line 1 is the title
         for (; k < lines.size(); ++k) {
             const std::string t = trim(lines[k]);
@@ -396,6 +416,12 @@ State import_peer_state(const std::filesystem::path& file, const Scene& scene)
     }
     for (std::size_t i = 0; i < n; ++i) {
         if (!seen[i]) throw Error(fmt::format("{}: atom id {} is missing", label, i + 1));
+        // The particles must fit the scene: inside its domain, not behind one of its walls.
+        for (int c = 0; c < 3; ++c)
+            if (!(component(x[i], c) >= component(scene.domain.min, c) && component(x[i], c) <= component(scene.domain.max, c)))
+                throw Error(fmt::format("{}: atom id {} at ({}, {}, {}) lies outside the domain of scene '{}' ({}, {}, {}) to ({}, {}, {})",
+                                        label, i + 1, x[i].x, x[i].y, x[i].z, scene.name, scene.domain.min.x, scene.domain.min.y,
+                                        scene.domain.min.z, scene.domain.max.x, scene.domain.max.y, scene.domain.max.z));
         if (!(radius[i] > 0.0) || !std::isfinite(radius[i])) throw Error(fmt::format("{}: atom id {} has radius {}", label, i + 1, radius[i]));
         if (std::abs(density[i] - scene.material.density) > 1e-12 * scene.material.density)
             throw Error(fmt::format("{}: atom id {} has density {}, the scene's material has {}", label, i + 1, density[i], scene.material.density));
@@ -407,8 +433,15 @@ State import_peer_state(const std::filesystem::path& file, const Scene& scene)
     State s;
     s.resize(n);
     s.dt = scene.dt;
-    s.step = 0;
-    s.walls = scene.walls;
+    s.step = step;
+    // The scene's walls where the scene puts them, moving from this step on (as continue_walls places a
+    // wall a saved state does not know; a data file carries no walls).
+    s.walls = continue_walls(scene, s);
+    for (std::size_t i = 0; i < n; ++i)
+        for (const Wall& wall : s.walls)
+            if (dot(x[i] - wall.point_at(step, scene.dt), wall.normal) < 0.0)
+                throw Error(fmt::format("{}: atom id {} at ({}, {}, {}) lies behind wall '{}' of scene '{}'", label, i + 1, x[i].x, x[i].y,
+                                        x[i].z, wall.name, scene.name));
     s.fingerprint = scene.fingerprint(n);
     s.radius = radius;
     s.trans.x = x;

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <fstream>
 #include <map>
 #include <set>
@@ -12,10 +13,13 @@
 #include <toml.hpp>
 
 #include "demmat/error.hpp"
+#include "demmat/io.hpp"
 
 namespace demmat {
 
 namespace {
+
+constexpr std::int64_t kIntMax = std::numeric_limits<int>::max();  // capacities, counts: stored as int
 
 // s with control characters shown as \xNN, for one-line messages.
 std::string printable(const std::string& s)
@@ -80,12 +84,26 @@ public:
         if (d < 0.0) fail(fmt::format("'{}' must be >= 0 (got {})", qualified(key), d));
         return d;
     }
-    std::int64_t integer(const std::string& key, std::int64_t fallback)
+    // An integer in [lo, hi]. The message quotes the number as written: toml11 clamps a literal beyond
+    // 64 bits to the nearest limit, and a narrowing cast would wrap (4294967297 into an int is 1).
+    std::int64_t integer(const std::string& key, std::int64_t fallback, std::int64_t lo, std::int64_t hi)
     {
         if (!has(key)) return fallback;
         const auto& x = raw(key);
         if (!x.is_integer()) fail(fmt::format("'{}' must be an integer", qualified(key)));
-        return x.as_integer();
+        const std::int64_t v = x.as_integer();
+        const auto where = x.location();
+        std::string text = std::to_string(v);
+        if (where.column() >= 1 && where.column() - 1 + where.region() <= where.line_str().size())
+            text = where.line_str().substr(where.column() - 1, where.region());
+        std::string digits;
+        for (char c : text)
+            if (c != '_' && c != '+') digits += c;
+        const bool clamped = (v == std::numeric_limits<std::int64_t>::max() || v == std::numeric_limits<std::int64_t>::min()) &&
+                             digits != std::to_string(v);
+        if (clamped || v < lo || v > hi)
+            fail(fmt::format("'{}' = {} is out of range ({} to {})", qualified(key), printable(text), lo, hi));
+        return v;
     }
     std::string string(const std::string& key, const std::string& fallback)
     {
@@ -333,17 +351,15 @@ Scene parse_scene(const std::string& text, const std::string& label)
     }
     if (top.has("capacity")) {
         Table t = top.table("capacity");
-        s.capacity.contacts_per_particle = int(t.integer("contacts_per_particle", s.capacity.contacts_per_particle));
-        s.capacity.wall_contacts_per_particle = int(t.integer("wall_contacts_per_particle", s.capacity.wall_contacts_per_particle));
-        if (s.capacity.contacts_per_particle < 1 || s.capacity.wall_contacts_per_particle < 1)
-            t.fail("capacities must be >= 1");
+        s.capacity.contacts_per_particle = int(t.integer("contacts_per_particle", s.capacity.contacts_per_particle, 1, kIntMax));
+        s.capacity.wall_contacts_per_particle =
+            int(t.integer("wall_contacts_per_particle", s.capacity.wall_contacts_per_particle, 1, kIntMax));
     }
     if (top.has("checks")) {
         Table t = top.table("checks");
-        s.checks.interval = int(t.integer("interval", s.checks.interval));
+        s.checks.interval = int(t.integer("interval", s.checks.interval, 0, kIntMax));
         s.checks.max_overlap_ratio = t.positive("max_overlap_ratio", s.checks.max_overlap_ratio);
         s.checks.max_speed = t.non_negative("max_speed", s.checks.max_speed);
-        if (s.checks.interval < 0) t.fail("'checks.interval' must be >= 0");
     }
 
     if (top.has("integrator")) {
@@ -361,10 +377,9 @@ Scene parse_scene(const std::string& text, const std::string& label)
     const std::string source = p.string("source", "");
     if (source == "grid") {
         GridGenerator g;
-        g.count = p.integer("count", 0);
-        if (g.count < 1) p.fail("'particles.count' must be >= 1");
+        if (!p.has("count")) p.fail("missing key 'count' in [particles] (source = \"grid\")");
         // The variants index particles with 32-bit integers (linked cells, neighbour lists).
-        if (g.count > 2147483647) p.fail(fmt::format("'particles.count' = {} exceeds the particle capacity 2147483647 (32-bit indices)", g.count));
+        g.count = p.integer("count", 0, 1, kIntMax);
         const auto r = p.numbers("radius", 2);
         g.radius_min = r[0];
         g.radius_max = r[1];
@@ -374,8 +389,7 @@ Scene parse_scene(const std::string& text, const std::string& label)
         g.speed_min = v[0];
         g.speed_max = v[1];
         if (g.speed_min < 0.0 || g.speed_max < g.speed_min) p.fail("'particles.speed' must be [min, max] with 0 <= min <= max");
-        const std::int64_t seed = p.integer("seed", 1);
-        if (seed < 0) p.fail("'particles.seed' must be >= 0");
+        const std::int64_t seed = p.integer("seed", 1, 0, std::numeric_limits<std::int64_t>::max());
         g.seed = std::uint64_t(seed);
         if (p.has("cells")) {
             const auto c = p.numbers("cells", 3);
@@ -413,11 +427,7 @@ Scene parse_scene(const std::string& text, const std::string& label)
 
 Scene load_scene(const std::filesystem::path& file)
 {
-    std::ifstream in(file, std::ios::binary);
-    if (!in) throw Error(fmt::format("{}: cannot open scene file: {}", file.string(), std::strerror(errno)));
-    std::ostringstream buf;
-    buf << in.rdbuf();
-    Scene s = parse_scene(buf.str(), file.string());
+    Scene s = parse_scene(read_input_file(file, "scene file", kMaxSceneBytes), file.string());
     s.source = file;
     if (!s.state_file.empty() && s.state_file.is_relative()) s.state_file = file.parent_path() / s.state_file;
     return s;

@@ -107,6 +107,11 @@ struct Scene {
     std::uint64_t fingerprint(std::size_t particle_count) const;
 };
 
+// The largest scene file read (1 GiB): a TOML scene is text a person edits; toml11 holds several times
+// the text in memory, and a list of 10^6 particles is about 200 MB (larger sets come from a state file
+// or the grid generator). The cap also stops a device such as /dev/zero at once (io.hpp, read_input_file).
+inline constexpr std::uintmax_t kMaxSceneBytes = std::uintmax_t(1) << 30;
+
 Scene load_scene(const std::filesystem::path& file);
 Scene parse_scene(const std::string& toml_text, const std::string& label);
 std::string scene_to_toml(const Scene& scene);
