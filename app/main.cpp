@@ -20,6 +20,7 @@
 #include "demmat/features.hpp"
 #include "demmat/io.hpp"
 #include "demmat/output.hpp"
+#include "demmat/problem.hpp"
 #include "demmat/provenance.hpp"
 #include "demmat/registry.hpp"
 #include "demmat/run_log.hpp"
@@ -34,12 +35,6 @@ using json = nlohmann::json;
 using namespace demmat;
 
 namespace {
-
-struct Loaded {
-    Scene scene;
-    State state;
-    Setup setup;
-};
 
 // The files a scene reads (itself and its state file): an output must not overwrite one.
 std::vector<NamedPath> scene_inputs(const Scene& s)
@@ -65,20 +60,18 @@ void override_integrator(Scene& s, const std::string& integrator, const std::str
     }
 }
 
-// Scene, initial state and setup, validated; the Setup points into the other two, so it lives with them.
-// `prepare` runs on the scene before its state is made and Δt is checked: a command's overrides of the
-// scene and the checks of its output paths, which must fail before any long work.
-std::unique_ptr<Loaded> load(const std::string& file, bool allow_unstable, const std::function<void(Scene&)>& prepare = {})
+// The problem of a scene file, validated. `prepare` runs on the scene before its state is made and Δt
+// is checked: a command's overrides of the scene and the checks of its output paths, which must fail
+// before any long work.
+std::unique_ptr<Problem> load(const std::string& file, bool allow_unstable, const std::function<void(Scene&)>& prepare = {})
 {
-    auto l = std::make_unique<Loaded>();
-    l->scene = load_scene(file);
-    if (prepare) prepare(l->scene);
-    l->state = initial_state(l->scene);
+    Scene scene = load_scene(file);
+    if (prepare) prepare(scene);
+    auto l = std::make_unique<Problem>(std::move(scene));
     if (!allow_unstable) {
-        const std::string warning = check_time_step(l->scene, l->state);
+        const std::string warning = check_time_step(l->scene(), l->state());
         if (!warning.empty()) std::cerr << "demmat: warning: " << warning << "\n";
     }
-    l->setup = Setup::make(l->scene, l->state);
     return l;
 }
 
@@ -105,24 +98,23 @@ std::vector<std::string> variant_list(const std::string& spec, bool allow_twice 
     return out;
 }
 
-json phase_json(const PhaseTimes& t, std::int64_t steps)
+json phase_json(const PhaseTimes& t)
 {
-    const double k = steps > 0 ? 1.0 / double(steps) : 0.0;
-    return {{"predict", t.predict * k}, {"search", t.search * k}, {"forces", t.forces * k}, {"correct", t.correct * k},
-            {"search_plus_forces", (t.search + t.forces) * k}, {"total", t.total() * k}};
+    return {{"predict", t.predict}, {"search", t.search}, {"forces", t.forces}, {"correct", t.correct},
+            {"search_plus_forces", t.search + t.forces}, {"total", t.total()}};
 }
 
-json scene_json(const Loaded& l)
+json scene_json(const Problem& l)
 {
-    const Scene& s = l.scene;
+    const Scene& s = l.scene();
     return {{"name", s.name},
             {"file", s.source.string()},
-            {"particles", l.state.size()},
+            {"particles", l.state().size()},
             {"dt", s.dt},
-            {"start_step", l.state.step},
+            {"start_step", l.state().step},
             {"search", s.search.method == SearchMethod::cells ? "cells" : "all_pairs"},
             {"cell_size_rmax", s.search.method == SearchMethod::cells ? s.search.cell_size : 0.0},
-            {"cell_size_m", l.setup.cell_size},
+            {"cell_size_m", l.setup().cell_size},
             {"integrator", name(s.integrator.scheme)},
             {"precision", name(s.integrator.precision)}};
 }
@@ -165,32 +157,32 @@ int cmd_run(const RunArgs& a)
         override_integrator(s, a.integrator, a.precision);
         check_run_outputs(a, s);
     });
-    const std::int64_t steps = steps_for(l->scene, a.steps, a.time);
+    const std::int64_t steps = steps_for(l->scene(), a.steps, a.time);
     auto variant = info.create();
-    Driver driver(*variant, l->setup);
+    Driver driver(*variant, l->setup());
 
     std::unique_ptr<VtkSeries> vtk;
     Snapshot snap;
     std::unique_ptr<RunLog> log;
     if (!a.log_file.empty()) {
-        check_log_path(a.log_file, {a.scene, l->scene.state_file});
-        log = std::make_unique<RunLog>(a.log_file, l->setup, a.log_every);
+        check_log_path(a.log_file, {a.scene, l->scene().state_file});
+        log = std::make_unique<RunLog>(a.log_file, l->setup(), a.log_every);
         variant->snapshot(snap);
         log->write(snap);
     }
     auto write_vtk = [&] {
         variant->snapshot(snap);
-        vtk->write(snap, l->state.radius, driver.time());
+        vtk->write(snap, l->state().radius, driver.time());
     };
     // Files named after the scene's name, made safe: a name such as "../../x" stays inside the folder.
-    const std::string vtk_stem = safe_file_stem(l->scene.name);
+    const std::string vtk_stem = safe_file_stem(l->scene().name);
     if (!a.vtk_dir.empty()) {
-        vtk = std::make_unique<VtkSeries>(a.vtk_dir, vtk_stem, l->scene.domain, l->state.walls, l->scene.dt);
+        vtk = std::make_unique<VtkSeries>(a.vtk_dir, vtk_stem, l->scene().domain, l->state().walls, l->scene().dt);
         write_vtk();
     }
     if (!a.quiet)
         std::cerr << fmt::format("demmat: {} on '{}': {} particles, {} walls, {} steps of {:g} s from step {}\n", info.name,
-                                 l->scene.name, l->state.size(), l->state.walls.size(), steps, l->scene.dt, l->state.step);
+                                 l->scene().name, l->state().size(), l->state().walls.size(), steps, l->scene().dt, l->state().step);
 
     using clock = std::chrono::steady_clock;
     const auto start = clock::now();
@@ -229,55 +221,53 @@ int cmd_run(const RunArgs& a)
 
     variant->snapshot(snap);
     const ContactCounts c = variant->counts();
-    const double n = double(l->state.size());
-    const double ke = kinetic_energy(snap, l->setup);
-    const PhaseTimes& t = driver.times();
-    const double per = 1.0 / double(std::max<std::int64_t>(1, steps));
-    std::cout << fmt::format("variant {}  scene {}  particles {}  steps {}  t = {:.6g} s\n", info.name, l->scene.name,
-                             l->state.size(), steps, driver.time());
-    std::cout << fmt::format("integrator {}\n", l->scene.integrator.describe());
+    const double n = double(l->state().size());
+    const double ke = kinetic_energy(snap, l->setup());
+    const PhaseTimes t = driver.times().per_step(steps);
+    std::cout << fmt::format("variant {}  scene {}  particles {}  steps {}  t = {:.6g} s\n", info.name, l->scene().name,
+                             l->state().size(), steps, driver.time());
+    std::cout << fmt::format("integrator {}\n", l->scene().integrator.describe());
     // The model instantiation the variant picked in init() (docs/design.md, "Model features").
     std::cout << fmt::format("model {}  (the scene needs {})\n", variant->model().name(),
-                             features_of(l->scene, l->state).name());
-    std::cout << fmt::format("steps per second {:.1f}  ({:.4f} us per particle-step)\n", double(steps) / t.total(),
-                             t.total() * per / n * 1e6);
+                             features_of(l->scene(), l->state()).name());
+    std::cout << fmt::format("steps per second {:.1f}  ({:.4f} us per particle-step)\n", 1.0 / t.total(),
+                             t.total() / n * 1e6);
     std::cout << fmt::format("per step: predict {:.3e} s  search {:.3e} s  forces {:.3e} s  correct {:.3e} s  total {:.3e} s\n",
-                             t.predict * per, t.search * per, t.forces * per, t.correct * per, t.total() * per);
+                             t.predict, t.search, t.forces, t.correct, t.total());
     std::cout << fmt::format("contacts per particle {:.3f} (particle-particle {}, particle-wall {})  kinetic energy {:.6e} J\n",
-                             (2.0 * double(c.particle_particle) + double(c.particle_wall)) / n, c.particle_particle,
-                             c.particle_wall, ke);
+                             c.per_particle(l->size()), c.particle_particle, c.particle_wall, ke);
     // Sampled: measured at the health checks only (every checks.interval steps and the last), not every step.
-    if (l->scene.checks.interval > 0)
+    if (l->scene().checks.interval > 0)
         std::cout << fmt::format("largest overlap at the health checks (sampled every {} steps and at the last) {:.3g} of the "
                                  "smaller radius (bound {})\n",
-                                 l->scene.checks.interval, driver.largest_overlap_ratio(), l->scene.checks.max_overlap_ratio);
+                                 l->scene().checks.interval, driver.largest_overlap_ratio(), l->scene().checks.max_overlap_ratio);
     std::cout << fmt::format("PERFORMANCE variant={} particles={} steps={} us_per_particle_step={:.5f} seconds={:.4f}\n",
-                             info.name, l->state.size(), steps, t.total() * per / n * 1e6, wall);
+                             info.name, l->state().size(), steps, t.total() / n * 1e6, wall);
 
     if (!a.save_file.empty()) {
         State out;
         variant->save(out);
-        out.dt = l->scene.dt;
-        out.fingerprint = l->state.fingerprint;
+        out.dt = l->scene().dt;
+        out.fingerprint = l->state().fingerprint;
         save_state(out, a.save_file);
     }
     if (!a.json_file.empty()) {
         json j = {{"provenance", provenance_json()},
                   {"scene", scene_json(*l)},
                   {"variant", info.name},
-                  {"model", {{"picked", variant->model().name()}, {"scene_needs", features_of(l->scene, l->state).name()}}},
+                  {"model", {{"picked", variant->model().name()}, {"scene_needs", features_of(l->scene(), l->state()).name()}}},
                   {"steps", steps},
                   {"threads", max_threads()},
                   {"end_time", driver.time()},
                   {"wall_seconds", wall},
-                  {"steps_per_second", double(steps) / t.total()},
-                  {"us_per_particle_step", t.total() * per / n * 1e6},
-                  {"seconds_per_step", phase_json(t, steps)},
+                  {"steps_per_second", 1.0 / t.total()},
+                  {"us_per_particle_step", t.total() / n * 1e6},
+                  {"seconds_per_step", phase_json(t)},
                   {"contacts", {{"particle_particle", c.particle_particle}, {"particle_wall", c.particle_wall},
-                                {"per_particle", (2.0 * double(c.particle_particle) + double(c.particle_wall)) / n}}},
+                                {"per_particle", c.per_particle(l->size())}}},
                   {"kinetic_energy", ke},
                   {"largest_overlap_ratio", driver.largest_overlap_ratio()},  // sampled at the health checks
-                  {"largest_overlap_sampled_every_steps", l->scene.checks.interval},  // 0: no checks, no sample
+                  {"largest_overlap_sampled_every_steps", l->scene().checks.interval},  // 0: no checks, no sample
                   {"memory_bytes", variant->memory_bytes()}};
         write_atomically(a.json_file, j.dump(2) + "\n");
     }
@@ -303,14 +293,14 @@ int cmd_compare(const std::string& scene, const std::string& variants, std::int6
     }
     if (variants == "all" && names.size() == 1) names.push_back(names.front());
     if (names.size() < 2) throw Error("compare needs at least two variants (a variant may be named twice)");
-    const std::int64_t k = steps_for(l->scene, steps, time);
-    const CompareReport r = compare_variants(names, l->setup, k);
+    const std::int64_t k = steps_for(l->scene(), steps, time);
+    const CompareReport r = compare_variants(names, l->setup(), k);
     if (r.difference) {
         std::cout << "differ: " << r.difference->describe() << "\n";
         return 1;
     }
     std::cout << fmt::format("identical: {} over {} steps of '{}' ({} particles)\n", fmt::join(names, ", "), r.steps,
-                             l->scene.name, l->state.size());
+                             l->scene().name, l->state().size());
     return 0;
 }
 
@@ -388,14 +378,9 @@ int cmd_bench(const BenchArgs& a)
             const std::string key = cfg.label();
             set_threads(cfg.threads);
             auto variant = registry().find(cfg.variant).create();
-            Driver driver(*variant, l->setup);
-            for (std::int64_t k = 0; k < a.warmup; ++k) driver.step();
-            const PhaseTimes before = driver.times();
-            driver.run(a.steps);
-            const PhaseTimes& after = driver.times();
-            const double per = 1.0 / double(a.steps);
-            const double v[4] = {(after.predict - before.predict) * per, (after.search - before.search) * per,
-                                 (after.forces - before.forces) * per, (after.correct - before.correct) * per};
+            Driver driver(*variant, l->setup());
+            const PhaseTimes t = measure_steps(driver, a.warmup, a.steps);
+            const double v[4] = {t.predict, t.search, t.forces, t.correct};
             for (int p = 0; p < 4; ++p) {
                 samples[key][phases[p]].push_back(v[p]);
                 reps.push_back({{"variant", cfg.variant},
@@ -411,7 +396,7 @@ int cmd_bench(const BenchArgs& a)
         std::cerr << fmt::format("demmat bench: repetition {}/{} done\n", r + 1, a.repetitions);
     }
     json summary = json::array();
-    const double n = double(l->state.size());
+    const double n = double(l->state().size());
     std::size_t width = 7;  // the longest variant name, so that the columns line up
     for (const auto& cfg : configs) width = std::max(width, cfg.variant.size());
     std::cout << fmt::format("{:<{}} {:>7} {:>12} {:>12} {:>12} {:>12} {:>12} {:>10}\n", "variant", width, "threads", "predict", "search",
@@ -433,7 +418,7 @@ int cmd_bench(const BenchArgs& a)
                            {"threads", cfg.threads},
                            {"seconds_per_step", ph},
                            {"us_per_particle_step", tot_med / n * 1e6},
-                           {"contacts_per_particle", (2.0 * double(c.particle_particle) + double(c.particle_wall)) / n},
+                           {"contacts_per_particle", c.per_particle(l->size())},
                            {"memory_bytes", memory[key]},
                            {"model", model[key]}});
         std::cout << fmt::format("{:<{}} {:>7} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e} {:>10.4f}\n", cfg.variant, width, cfg.threads,

@@ -57,6 +57,14 @@ KineticEnergy kinetic_energy_parts(const Snapshot& s, const Setup& setup)
     return e;
 }
 
+PhaseTimes measure_steps(Driver& driver, std::int64_t warmup, std::int64_t steps, const std::function<void(std::int64_t)>& after_step)
+{
+    for (std::int64_t k = 0; k < warmup; ++k) driver.step();
+    const PhaseTimes before = driver.times();
+    driver.run(steps, after_step);  // with the health checks: a blown-up run is not measured
+    return (driver.times() - before).per_step(steps);
+}
+
 double kinetic_energy(const Snapshot& s, const Setup& setup)
 {
     const KineticEnergy e = kinetic_energy_parts(s, setup);

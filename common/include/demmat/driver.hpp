@@ -15,6 +15,15 @@ namespace demmat {
 struct PhaseTimes {  // seconds, summed over the steps taken
     double predict = 0.0, search = 0.0, forces = 0.0, correct = 0.0;
     double total() const { return predict + search + forces + correct; }
+    PhaseTimes operator-(const PhaseTimes& o) const
+    {
+        return {predict - o.predict, search - o.search, forces - o.forces, correct - o.correct};
+    }
+    PhaseTimes per_step(std::int64_t steps) const
+    {
+        const double k = steps > 0 ? 1.0 / double(steps) : 0.0;
+        return {predict * k, search * k, forces * k, correct * k};
+    }
 };
 
 class Driver {
@@ -56,6 +65,12 @@ private:
     double energy0_ = 0.0, energy_floor_ = 0.0;
     bool energy_check_ = false;
 };
+
+// The one measurement of a variant's phases: `warmup` steps left out of the result (first touches, first
+// list builds), then `steps` steps run as run() runs them (health checks included) whose phase times,
+// per step, are returned; after_step as in run() (e.g. to accumulate contact counts).
+PhaseTimes measure_steps(Driver& driver, std::int64_t warmup, std::int64_t steps,
+                         const std::function<void(std::int64_t)>& after_step = {});
 
 // Kinetic energy (translational + rotational) of a snapshot, summed in id order, and its two parts.
 struct KineticEnergy {

@@ -42,6 +42,8 @@ struct ContactCounts {
     std::int64_t particle_particle = 0;  // contacts with h > 0 found by the last forces phase
     std::int64_t particle_wall = 0;
     std::int64_t candidates = 0;         // pairs the last search kept for the forces phase
+    // Contacts per particle among n: a pair counts for both its particles, a wall contact for one.
+    double per_particle(std::size_t n) const { return (2.0 * double(particle_particle) + double(particle_wall)) / double(n); }
 };
 
 class Variant {
