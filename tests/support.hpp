@@ -10,6 +10,7 @@
 #include "demmat/checker.hpp"
 #include "demmat/driver.hpp"
 #include "demmat/error.hpp"
+#include "demmat/problem.hpp"
 #include "demmat/registry.hpp"
 #include "demmat/scenes.hpp"
 
@@ -58,21 +59,7 @@ struct VariantRun {
 inline const std::int64_t kSettleSteps = 12000;
 inline State settling_bed_state(const Scene& bed)
 {
-    const std::filesystem::path cache = "equivalence_bed_2000_12000.state";
-    try {
-        State st = load_state(cache);
-        if (st.fingerprint == bed.fingerprint(st.size()) && st.step == kSettleSteps) return st;
-    } catch (const Error&) {
-    }
-    Case c(bed);
-    VariantRun run("arrays", c.setup);
-    run.driver->run(kSettleSteps);
-    State st;
-    run.variant->save(st);
-    st.dt = bed.dt;
-    st.fingerprint = c.state.fingerprint;
-    save_state(st, cache);
-    return st;
+    return settled_state(bed, kSettleSteps, "equivalence_bed_2000_12000.state", registry().find("arrays").create);
 }
 
 // The settling bed as a scene that starts from the cached state; with `wall_speed` > 0, the paper's
