@@ -19,7 +19,7 @@ namespace demmat::gpu {
 
 // Throws the run-stopping error a non-zero status word reports (status.cpp, host code).
 void throw_status(const unsigned long long (&status)[kStatusWords], std::uint32_t cap_above, std::uint32_t row_cap,
-                  std::uint32_t cap_walls);
+                  std::uint32_t cap_walls, std::size_t walls);
 // Refuses a scene the variant cannot hold (more than kMaxWalls walls, 2^32 − 1 particles).
 void check_size(std::size_t particles, std::size_t walls);
 
@@ -130,7 +130,7 @@ public:
         }
         unsigned long long status[kStatusWords];
         be_.download(status, v_.status, kStatusWords);  // synchronises
-        throw_status(status, v_.cap_above, v_.row_cap, v_.cap_walls);
+        throw_status(status, v_.cap_above, v_.row_cap, v_.cap_walls, walls_.size());
     }
 
     void forces() override

@@ -20,7 +20,7 @@ inline constexpr int kMaxWalls = 32;   // walls of a scene the variant runs (a b
 inline constexpr int kGearArrays = 12;  // x v a b3 b4 b5, then the rotational six (physics.md §1)
 
 // Status words the search reports (max-combined, so the result does not depend on thread order):
-// the worst candidate count as count << 32 | particle id.
+// the worst count and its lowest particle id as count << 32 | (2^32 − 1 − id); kRunaway: id + 1.
 enum StatusWord { kAboveOverflow, kRowOverflow, kWallOverflow, kRunaway, kStatusWords };
 
 // One buffer of the per-particle arrays, in cell order: (N, 3) arrays stored column by column, as the
@@ -263,7 +263,7 @@ struct Search {
             for (std::uint32_t q = 0; q < v.n; ++q)
                 if (q != p) consider(p, q, total, above, row);
         }
-        const std::uint64_t id = v.p.id[p];
+        const std::uint64_t id = 0xffffffffu - v.p.id[p];  // ties of the count go to the lowest id, as in arrays
         if (above > v.cap_above) status_max(&v.status[kAboveOverflow], std::uint64_t(above) << 32 | id);
         if (total > v.row_cap) status_max(&v.status[kRowOverflow], std::uint64_t(total) << 32 | id);
         v.row_count[p] = total < v.row_cap ? total : v.row_cap;

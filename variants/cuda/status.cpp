@@ -8,10 +8,10 @@
 namespace demmat::gpu {
 
 void throw_status(const unsigned long long (&status)[kStatusWords], std::uint32_t cap_above, std::uint32_t row_cap,
-                  std::uint32_t cap_walls)
+                  std::uint32_t cap_walls, std::size_t walls)
 {
     auto count = [](unsigned long long w) { return std::int64_t(w >> 32); };
-    auto particle = [](unsigned long long w) { return std::int64_t(w & 0xffffffffu); };
+    auto particle = [](unsigned long long w) { return std::int64_t(0xffffffffu - (w & 0xffffffffu)); };
     if (const auto w = status[kRunaway])
         throw InstabilityError(fmt::format("particle {} has a non-finite or runaway position (found by the cell search)", w - 1), -1,
                                std::int64_t(w - 1));
@@ -24,7 +24,7 @@ void throw_status(const unsigned long long (&status)[kStatusWords], std::uint32_
                                         cap_above, particle(w), count(w), (count(w) + 1) / 2));
     if (const auto w = status[kWallOverflow])
         throw CapacityError(fmt::format("capacity.wall_contacts_per_particle = {} exceeded: particle {} touches more walls; set it to "
-                                        "{} (the number of walls)", cap_walls, particle(w), count(w)));
+                                        "{} (the number of walls)", cap_walls, particle(w), walls));
     (void)row_cap;
 }
 
