@@ -28,7 +28,9 @@ elseif(DEMMAT_CUDA)
     # division and square root, no flush to zero; the host side of the file as every C++ file.
     set_property(TARGET demmat_variant_cuda PROPERTY COMPILE_OPTIONS
       -std=c++20 --fmad=false -prec-div=true -prec-sqrt=true -ftz=false -Xcompiler=-ffp-contract=off,-fno-fast-math,-Wall,-Wextra)
+    # No CUDA_STANDARD (CMake would take CXX_STANDARD 20 for it and knows no nvcc 13 flag): -std above.
     set_target_properties(demmat_variant_cuda PROPERTIES CUDA_RUNTIME_LIBRARY Static)
+    set_property(TARGET demmat_variant_cuda PROPERTY CXX_STANDARD)
   else()
     message(STATUS "demmat: no CUDA compiler: the cuda variant is left out")
   endif()
