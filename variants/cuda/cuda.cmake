@@ -21,16 +21,20 @@ elseif(DEMMAT_CUDA)
     # The static CUDA runtime: the binaries run on a GPU machine without the toolkit (the driver suffices).
     set(CMAKE_CUDA_RUNTIME_LIBRARY Static)
     enable_language(CUDA)
+    # CMake 3.25 knows no C++20 flag for nvcc 13 (nvcc has it): tell it, so that CUDA_STANDARD 20 works.
+    if(NOT CMAKE_CUDA20_STANDARD_COMPILE_OPTION)
+      set(CMAKE_CUDA20_STANDARD_COMPILE_OPTION -std=c++20)
+      set(CMAKE_CUDA20_EXTENSION_COMPILE_OPTION -std=c++20)
+      list(APPEND CMAKE_CUDA_COMPILE_FEATURES cuda_std_20)
+    endif()
     find_package(CUDAToolkit REQUIRED)
     demmat_add_variant(cuda SOURCES cuda/cuda.cu LIBS demmat_variant_cuda_host CUDA::cudart_static)
-    # The directory's GCC options are not nvcc's: the file gets its own (C++20 by hand: CMake 3.25 has no CUDA 20
-    # flag for nvcc 13). No FMA contraction, IEEE
+    # The directory's GCC options are not nvcc's: the file gets its own. No FMA contraction, IEEE
     # division and square root, no flush to zero; the host side of the file as every C++ file.
     set_property(TARGET demmat_variant_cuda PROPERTY COMPILE_OPTIONS
-      -std=c++20 --fmad=false -prec-div=true -prec-sqrt=true -ftz=false -Xcompiler=-ffp-contract=off,-fno-fast-math,-Wall,-Wextra)
-    # No CUDA_STANDARD (CMake would take CXX_STANDARD 20 for it and knows no nvcc 13 flag): -std above.
-    set_target_properties(demmat_variant_cuda PROPERTIES CUDA_RUNTIME_LIBRARY Static)
-    set_property(TARGET demmat_variant_cuda PROPERTY CXX_STANDARD)
+      --fmad=false -prec-div=true -prec-sqrt=true -ftz=false -Xcompiler=-ffp-contract=off,-fno-fast-math,-Wall,-Wextra)
+    set_target_properties(demmat_variant_cuda PROPERTIES CUDA_STANDARD 20 CUDA_STANDARD_REQUIRED ON CUDA_EXTENSIONS OFF
+                                                         CUDA_RUNTIME_LIBRARY Static)
   else()
     message(STATUS "demmat: no CUDA compiler: the cuda variant is left out")
   endif()

@@ -73,23 +73,12 @@ public:
             b->id = be_.template alloc<std::uint32_t>(n);
             b->cell = be_.template alloc<std::uint64_t>(n);
         }
-        v_.force = be_.template alloc<double>(n3);
-        v_.torque = be_.template alloc<double>(n3);
-        v_.acc = be_.template alloc<double>(n3);
-        v_.alpha = be_.template alloc<double>(n3);
+        for (double** a : {&v_.force, &v_.torque, &v_.acc, &v_.alpha}) *a = be_.template alloc<double>(n3);
         v_.row = be_.template alloc<std::uint64_t>(std::size_t(n) * v_.row_cap);
-        v_.row_count = be_.template alloc<std::uint32_t>(n);
-        v_.wall_mask = be_.template alloc<std::uint32_t>(n);
-        v_.candidates = be_.template alloc<std::uint32_t>(n);
-        v_.contacts = be_.template alloc<std::uint32_t>(n);
-        v_.wall_contacts = be_.template alloc<std::uint32_t>(n);
-        v_.key = be_.template alloc<std::uint64_t>(n);
-        v_.sorted_key = be_.template alloc<std::uint64_t>(n);
-        v_.key_slot = be_.template alloc<std::uint32_t>(n);
-        v_.sorted_slot = be_.template alloc<std::uint32_t>(n);
-        v_.cell_tmp = be_.template alloc<std::uint64_t>(n);
-        v_.bucket_begin = be_.template alloc<std::uint32_t>(buckets);
-        v_.bucket_end = be_.template alloc<std::uint32_t>(buckets);
+        for (std::uint32_t** a : {&v_.row_count, &v_.wall_mask, &v_.candidates, &v_.contacts, &v_.wall_contacts, &v_.key_slot, &v_.sorted_slot})
+            *a = be_.template alloc<std::uint32_t>(n);
+        for (std::uint64_t** a : {&v_.key, &v_.sorted_key, &v_.cell_tmp}) *a = be_.template alloc<std::uint64_t>(n);
+        for (std::uint32_t** a : {&v_.bucket_begin, &v_.bucket_end}) *a = be_.template alloc<std::uint32_t>(buckets);
         v_.status = be_.template alloc<unsigned long long>(kStatusWords);
 
         // Slot = id to start with (the first search sorts).

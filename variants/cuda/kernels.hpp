@@ -110,36 +110,31 @@ DEMMAT_HD inline bool item(unsigned block, unsigned thread, unsigned dim, std::u
 
 // ---- predictor and corrector: one thread per component -------------------------------------------------
 
-template <class M>
-struct Predict {
+// Corrector = false: the predictor; true: the corrector, its Δa a value before a changes (as
+// Gear5Scheme::correct, integrators.hpp).
+template <class M, bool Corrector>
+struct GearStep {
     View v;
     DEMMAT_HD void operator()(unsigned block, unsigned thread, unsigned dim) const
     {
         std::uint64_t e;
         if (!item(block, thread, dim, 3ull * v.n, e)) return;
         double* const* g = v.p.gear;
-        gear_predict(g[0][e], g[1][e], g[2][e], g[3][e], g[4][e], g[5][e], v.gear);
-        if constexpr (M::rotation) gear_predict(g[6][e], g[7][e], g[8][e], g[9][e], g[10][e], g[11][e], v.gear);
-    }
-};
-
-template <class M>
-struct Correct {
-    View v;
-    DEMMAT_HD void operator()(unsigned block, unsigned thread, unsigned dim) const
-    {
-        std::uint64_t e;
-        if (!item(block, thread, dim, 3ull * v.n, e)) return;
-        double* const* g = v.p.gear;
-        // As Gear5Scheme::correct (integrators.hpp): da a value before a changes.
-        const double da = v.acc[e] - g[2][e];
-        gear_correct(g[0][e], g[1][e], g[2][e], g[3][e], g[4][e], g[5][e], da, v.gear);
-        if constexpr (M::rotation) {
-            const double dw = v.alpha[e] - g[8][e];
-            gear_correct(g[6][e], g[7][e], g[8][e], g[9][e], g[10][e], g[11][e], dw, v.gear);
+        for (int r = 0; r < (M::rotation ? 2 : 1); ++r) {  // translation; rotation (arrays 6..11)
+            double* const* q = g + 6 * r;
+            if constexpr (Corrector) {
+                const double da = (r == 0 ? v.acc : v.alpha)[e] - q[2][e];
+                gear_correct(q[0][e], q[1][e], q[2][e], q[3][e], q[4][e], q[5][e], da, v.gear);
+            } else {
+                gear_predict(q[0][e], q[1][e], q[2][e], q[3][e], q[4][e], q[5][e], v.gear);
+            }
         }
     }
 };
+template <class M>
+using Predict = GearStep<M, false>;
+template <class M>
+using Correct = GearStep<M, true>;
 
 // ---- search: keys, (sort), gather, buckets, candidates ---------------------------------------------------
 
