@@ -67,6 +67,9 @@ struct View {
     Walls walls;
 };
 
+// Kernels take their View by value, as launch parameters (CUDA's limit: 4 KB on every device).
+static_assert(sizeof(View) <= 4096, "a kernel's View must fit CUDA's 4 KB of launch parameters");
+
 // ---- small helpers -----------------------------------------------------------------------------------
 
 DEMMAT_HD inline Vec3<double> get(const double* a, std::uint32_t n, std::uint32_t s) { return {a[s], a[n + s], a[2 * n + s]}; }
