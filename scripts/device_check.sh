@@ -110,6 +110,7 @@ say "== provenance"
 { date -u; uname -a; nproc; } > "$res/host.txt"
 lscpu >> "$res/host.txt" 2>/dev/null
 nvidia-smi > "$res/nvidia-smi.txt" 2>&1
+nvidia-smi --query-gpu=name,driver_version,compute_cap,memory.total --format=csv 2>&1 | tee -a "$log"
 nvidia-smi -q >> "$res/nvidia-smi.txt" 2>&1
 cp "$dist/build-info.txt" "$dist/ptx-check.txt" "$res/" 2>/dev/null
 if command -v cuobjdump >/dev/null; then
