@@ -586,7 +586,9 @@ int main(int argc, char** argv)
         if (*list) {
             std::size_t width = 0;
             for (const auto& v : registry().all()) width = std::max(width, v.name.size());
+            for (const auto& u : registry().unavailable()) width = std::max(width, u.first.size());
             for (const auto& v : registry().all()) std::cout << fmt::format("{:<{}}  {}\n", v.name, width, v.summary);
+            for (const auto& [name, why] : registry().unavailable()) std::cout << fmt::format("{:<{}}  unavailable: {}\n", name, width, why);
             return 0;
         }
         if (*scene) return cmd_scene(sa);

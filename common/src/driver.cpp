@@ -31,12 +31,22 @@ Setup Setup::make(const Scene& scene, const State& state)
     return s;
 }
 
-void Registry::add(VariantInfo info) { variants_.push_back(std::move(info)); }
+void Registry::add(VariantInfo info)
+{
+    if (info.unavailable)
+        if (std::string why = info.unavailable(); !why.empty()) {
+            unavailable_.emplace_back(info.name, std::move(why));
+            return;
+        }
+    variants_.push_back(std::move(info));
+}
 
 const VariantInfo& Registry::find(std::string_view name) const
 {
     for (const auto& v : variants_)
         if (v.name == name) return v;
+    for (const auto& [n, why] : unavailable_)
+        if (n == name) throw Error(fmt::format("variant '{}' cannot run here: {}", name, why));
     throw Error(fmt::format("unknown variant '{}' (known: {})", name, fmt::join(names(), ", ")));
 }
 

@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "demmat/host_device.hpp"
 #include "demmat/lanes.hpp"
 #include "demmat/model.hpp"
 #include "demmat/vec3.hpp"
@@ -42,7 +43,7 @@ struct ContactForce {
 // superset of the contact set, and the law alone decides; the trajectory then cannot depend on the
 // search method.
 template <class T>
-inline bool may_touch(const Vec3<T>& xi, const Vec3<T>& xj, T ri, T rj)
+DEMMAT_HD inline bool may_touch(const Vec3<T>& xi, const Vec3<T>& xj, T ri, T rj)
 {
     const Vec3<T> dx = xj - xi;
     const T d2 = dot(dx, dx);
@@ -61,7 +62,7 @@ inline auto may_touch_lanes(const Vec3<V>& xi, const Vec3<V>& xj, V ri, V rj)
     return d2 < s * s * LaneScalar<V>(1.000000001);
 }
 template <class T>
-inline bool may_touch_wall(const Vec3<T>& xi, T ri, const Vec3<T>& point, const Vec3<T>& normal)
+DEMMAT_HD inline bool may_touch_wall(const Vec3<T>& xi, T ri, const Vec3<T>& point, const Vec3<T>& normal)
 {
     // The law tests ri - s > 0 with exactly this s; the margin only makes the list a superset.
     return dot(xi - point, normal) < ri * T(1.000000001);
@@ -78,17 +79,17 @@ struct Coefficients {
 };
 
 template <class T, class S>
-inline Coefficients<T> coefficients(S hertz, T rstar, T mstar, const ContactParams<S>& p)
+DEMMAT_HD inline Coefficients<T> coefficients(S hertz, T rstar, T mstar, const ContactParams<S>& p)
 {
     return {hertz * lane_sqrt(rstar), p.gamma_n * mstar, p.gamma_t * mstar};
 }
 template <class T, class S>
-inline Coefficients<T> pair_coefficients(T ri, T rj, T mi, T mj, const ContactParams<S>& p)
+DEMMAT_HD inline Coefficients<T> pair_coefficients(T ri, T rj, T mi, T mj, const ContactParams<S>& p)
 {
     return coefficients(p.hertz_pp, ri * rj / (ri + rj), mi * mj / (mi + mj), p);
 }
 template <class T, class S>
-inline Coefficients<T> wall_coefficients(T ri, T mi, const ContactParams<S>& p)
+DEMMAT_HD inline Coefficients<T> wall_coefficients(T ri, T mi, const ContactParams<S>& p)
 {
     return coefficients(p.hertz_pw, ri, mi, p);  // R* = R_i, m* = m_i
 }
@@ -99,7 +100,7 @@ namespace detail {
 // relative velocity u of i with respect to the partner at the contact point). The two branches of the
 // law (the clip and a zero tangential speed) are selects, so a pack of lanes runs the same code.
 template <class M, class T, class S>
-inline void contact_force(const Vec3<T>& n, T h, const Vec3<T>& u, const Coefficients<T>& k, const ContactParams<S>& p,
+DEMMAT_HD inline void contact_force(const Vec3<T>& n, T h, const Vec3<T>& u, const Coefficients<T>& k, const ContactParams<S>& p,
                           Vec3<T>& f_i, Vec3<T>& f_t)
 {
     const T zero{};
@@ -125,7 +126,7 @@ inline void contact_force(const Vec3<T>& n, T h, const Vec3<T>& u, const Coeffic
 
 // The centre-to-centre vector, its length and the overlap h = R_i + R_j − d of a pair.
 template <class T>
-inline T pair_overlap(const Vec3<T>& xi, const Vec3<T>& xj, T ri, T rj, Vec3<T>& dx, T& d)
+DEMMAT_HD inline T pair_overlap(const Vec3<T>& xi, const Vec3<T>& xj, T ri, T rj, Vec3<T>& dx, T& d)
 {
     dx = xj - xi;
     d = lane_sqrt(dot(dx, dx));
@@ -134,7 +135,7 @@ inline T pair_overlap(const Vec3<T>& xi, const Vec3<T>& xj, T ri, T rj, Vec3<T>&
 
 // The particle–particle law once the overlap h > 0 is known (in every lane whose result is kept).
 template <class M, class T, class S>
-inline void pair_law(const Vec3<T>& dx, T d, T h, const Vec3<T>& vi, const Vec3<T>& vj, const Vec3<T>& wi, const Vec3<T>& wj,
+DEMMAT_HD inline void pair_law(const Vec3<T>& dx, T d, T h, const Vec3<T>& vi, const Vec3<T>& vj, const Vec3<T>& wi, const Vec3<T>& wj,
                      T ri, T rj, T mi, T mj, const ContactParams<S>& p, const Coefficients<T>& mono, ContactForce<T>& out)
 {
     const Vec3<T> n = dx / d;
@@ -158,7 +159,7 @@ inline void pair_law(const Vec3<T>& dx, T d, T h, const Vec3<T>& vi, const Vec3<
 // pair_coefficients of the scene's one radius and mass; only a model with !M::polydisperse reads it, a
 // polydisperse one computes the pair's own from r_i, r_j, m_i, m_j.
 template <class M, class T>
-inline bool particle_contact(const Vec3<T>& xi, const Vec3<T>& xj, const Vec3<T>& vi, const Vec3<T>& vj,
+DEMMAT_HD inline bool particle_contact(const Vec3<T>& xi, const Vec3<T>& xj, const Vec3<T>& vi, const Vec3<T>& vj,
                              const Vec3<T>& wi, const Vec3<T>& wj, T ri, T rj, T mi, T mj,
                              const ContactParams<T>& p, const Coefficients<T>& mono, ContactForce<T>& out)
 {
@@ -172,7 +173,7 @@ inline bool particle_contact(const Vec3<T>& xi, const Vec3<T>& xj, const Vec3<T>
 
 // The same for a polydisperse model, whose callers hold no monodisperse coefficients.
 template <class M, class T>
-inline bool particle_contact(const Vec3<T>& xi, const Vec3<T>& xj, const Vec3<T>& vi, const Vec3<T>& vj,
+DEMMAT_HD inline bool particle_contact(const Vec3<T>& xi, const Vec3<T>& xj, const Vec3<T>& vi, const Vec3<T>& vj,
                              const Vec3<T>& wi, const Vec3<T>& wj, T ri, T rj, T mi, T mj,
                              const ContactParams<T>& p, ContactForce<T>& out)
 {
@@ -205,7 +206,7 @@ inline auto particle_contact_lanes(const Vec3<V>& xi, const Vec3<V>& xj, const V
 namespace detail {
 // The particle–wall law once the overlap h > 0 is known (in every lane whose result is kept).
 template <class M, class T, class S>
-inline void wall_law(T h, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T mi, const Vec3<T>& normal, const Vec3<T>& vw,
+DEMMAT_HD inline void wall_law(T h, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T mi, const Vec3<T>& normal, const Vec3<T>& vw,
                      const ContactParams<S>& p, const Coefficients<T>& mono, ContactForce<T>& out)
 {
     const Vec3<T> n = -normal;
@@ -226,7 +227,7 @@ inline void wall_law(T h, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T mi, cons
 // zero, and v_i − 0 = v_i exactly); R* = R_i, m* = m_i, E* from the particle and wall materials. `mono`
 // as for particle_contact, from wall_coefficients.
 template <class M, class T>
-inline bool wall_contact(const Vec3<T>& xi, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T mi,
+DEMMAT_HD inline bool wall_contact(const Vec3<T>& xi, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T mi,
                          const Vec3<T>& point, const Vec3<T>& normal, const Vec3<T>& vw,
                          const ContactParams<T>& p, const Coefficients<T>& mono, ContactForce<T>& out)
 {
@@ -256,7 +257,7 @@ inline auto wall_contact_lanes(const Vec3<V>& xi, const Vec3<V>& vi, const Vec3<
 }
 
 template <class M, class T>
-inline bool wall_contact(const Vec3<T>& xi, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T mi,
+DEMMAT_HD inline bool wall_contact(const Vec3<T>& xi, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T mi,
                          const Vec3<T>& point, const Vec3<T>& normal, const Vec3<T>& vw,
                          const ContactParams<T>& p, ContactForce<T>& out)
 {
@@ -266,6 +267,6 @@ inline bool wall_contact(const Vec3<T>& xi, const Vec3<T>& vi, const Vec3<T>& wi
 
 // Newton's second law with gravity (physics.md §4 step 7): a = F/m + g, α = T/I.
 template <class T>
-inline T acceleration(T force, T mass, T gravity) { return force / mass + gravity; }
+DEMMAT_HD inline T acceleration(T force, T mass, T gravity) { return force / mass + gravity; }
 
 } // namespace demmat

@@ -3,6 +3,7 @@
 // once. The kernels are templates on the value type V: a variant calls them on one double (a plain
 // loop), on one float, or on a whole Eigen array (an element-wise expression evaluates exactly the same
 // operations in the same order for every element).
+#include "demmat/host_device.hpp"
 
 namespace demmat {
 
@@ -38,7 +39,7 @@ struct GearCoefficients {
 // Predictor: Taylor expansion of the six values (Pascal's triangle on the scaled derivatives).
 // Updated in place in this order so that each line reads only values not yet predicted.
 template <class V, class T>
-inline void gear_predict(V& x, V& v, V& a, V& b3, V& b4, const V& b5, const GearCoefficients<T>& k)
+DEMMAT_HD inline void gear_predict(V& x, V& v, V& a, V& b3, V& b4, const V& b5, const GearCoefficients<T>& k)
 {
     x = x + k.dt * v + k.half_dt2 * a + b3 + b4 + b5;
     v = v + k.dt * a + (T(3) * b3 + T(4) * b4 + T(5) * b5) / k.dt;
@@ -49,7 +50,7 @@ inline void gear_predict(V& x, V& v, V& a, V& b3, V& b4, const V& b5, const Gear
 
 // Corrector, with da = a_corrected − a_predicted already evaluated (a value, not a lazy expression).
 template <class V, class D, class T>
-inline void gear_correct(V& x, V& v, V& a, V& b3, V& b4, V& b5, const D& da, const GearCoefficients<T>& k)
+DEMMAT_HD inline void gear_correct(V& x, V& v, V& a, V& b3, V& b4, V& b5, const D& da, const GearCoefficients<T>& k)
 {
     x = x + k.cx * da;
     v = v + k.cv * da;

@@ -10,6 +10,8 @@
 #include <type_traits>
 #include <utility>
 
+#include "demmat/host_device.hpp"
+
 #if defined(__SSE2__)
 #include <immintrin.h>
 #endif
@@ -47,8 +49,8 @@ using LaneScalar = std::remove_cvref_t<decltype(std::declval<V&>()[0])>;
 template <LanePack V>
 inline constexpr int lane_count = int(sizeof(V) / sizeof(LaneScalar<V>));
 
-inline double lane_sqrt(double a) { return std::sqrt(a); }
-inline float lane_sqrt(float a) { return std::sqrt(a); }
+DEMMAT_HD inline double lane_sqrt(double a) { return std::sqrt(a); }
+DEMMAT_HD inline float lane_sqrt(float a) { return std::sqrt(a); }
 
 template <LanePack V>
 inline V lane_sqrt(V a)
@@ -75,11 +77,11 @@ inline V lane_sqrt(V a)
 
 // std::min's definition, (b < a) ? b : a, for scalars and lane by lane for packs.
 template <class T>
-inline T lane_min(T a, T b) { return b < a ? b : a; }
+DEMMAT_HD inline T lane_min(T a, T b) { return b < a ? b : a; }
 
 // Every lane s (a pack built from a scalar), or s itself for a scalar type.
 template <class V, class S>
-inline V splat(S s)
+DEMMAT_HD inline V splat(S s)
 {
     if constexpr (std::is_arithmetic_v<V>) {
         return V(s);

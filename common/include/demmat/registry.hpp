@@ -6,6 +6,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include "demmat/variant.hpp"
@@ -18,6 +19,10 @@ struct VariantInfo {
     std::function<std::unique_ptr<Variant>()> create;
     bool bitwise = true;    // bit-identical to arrays at every step (false: drops the canonical order on purpose)
     bool threaded = false;  // uses set_threads() threads (demmat/threads.hpp); benchmarks also time it at 1
+    // Set for a variant that may be built but unable to run here (the cuda variant without a GPU): returns
+    // why, or "" when it can run. An unavailable variant is left out of all(), names() and find(); `demmat
+    // list` shows it with the reason.
+    std::function<std::string()> unavailable{};
 };
 
 class Registry {
@@ -26,9 +31,12 @@ public:
     const std::vector<VariantInfo>& all() const { return variants_; }
     const VariantInfo& find(std::string_view name) const;  // throws Error naming the known variants
     std::vector<std::string> names() const;
+    // Built-in variants that cannot run here: (name, reason).
+    const std::vector<std::pair<std::string, std::string>>& unavailable() const { return unavailable_; }
 
 private:
     std::vector<VariantInfo> variants_;
+    std::vector<std::pair<std::string, std::string>> unavailable_;
 };
 
 // All variants built into this program (defined in the generated registration file).

@@ -1,0 +1,159 @@
+#!/usr/bin/env bash
+# The cuda variant's check on a GPU machine (docs/cuda.md, "The device check"). Two modes:
+#
+#   scripts/device_check.sh --pack      on the build machine: builds build-gpu/ (portable flags) and packs
+#                                       build-gpu/dist/ (demmat and the shared libraries it needs beside it)
+#   scripts/device_check.sh             on the GPU machine, from the repository root, with build-gpu/dist/
+#                                       carried there: provenance, the bitwise comparisons, the benchmark
+#
+# The run writes results/gpu/ (and copies it under $OUT when $OUT is set): nvidia-smi, the code the
+# binary carries, `demmat compare` of cuda against arrays (dense bed and compression stage, 1000 steps),
+# and `demmat bench` of cuda beside fast at 16 threads and at 1 on dense beds of 10^4, 10^5 and 10^6
+# grains settled on the device, and on the loose lattice of 10^7. It keeps to a time budget (BUDGET_S,
+# default 450 s): a stage that no longer fits is skipped and says so in results/gpu/log.txt.
+# Knobs: BUDGET_S, SETTLE_TIME (simulated seconds of settling, default 0.15: the 12-layer bed has
+# collapsed by then), SIZES (default "10000 100000 1000000"), BIG (default 10000000; 0 skips it),
+# CMP_N and CMP_STEPS (the comparisons' bed and length, default 2000 and 1000), RESULTS (default
+# results/gpu). VARIANT=cuda_host runs the whole flow on the CPU, to try the script without a GPU.
+set -uo pipefail
+cd "$(dirname "$0")/.."
+
+dist=build-gpu/dist
+
+if [[ "${1:-}" == "--pack" ]]; then
+  set -e
+  # Portable code for an unknown host CPU: fast without -march=native (bit-identical either way).
+  cmake -S . -B build-gpu -DCMAKE_BUILD_TYPE=Release -DDEMMAT_FAST_NATIVE=OFF -DDEMMAT_BUILD_BENCH=OFF \
+        -DCMAKE_EXE_LINKER_FLAGS="-static-libstdc++ -static-libgcc" ${CCACHE_DIR:+-DCMAKE_CXX_COMPILER_LAUNCHER=ccache} >/dev/null
+  cmake --build build-gpu -j"${JOBS:-2}" --target demmat
+  rm -rf "$dist" && mkdir -p "$dist/bin" "$dist/lib" "$dist/glibc"
+  cp build-gpu/app/demmat "$dist/bin/"
+  # Every shared library it needs beside it; the C library apart, in glibc/, used (through its own
+  # loader) only where the GPU machine's glibc is older than the one the binary was linked against.
+  ldd build-gpu/app/demmat | awk '/=> \//{print $3} /ld-linux/{print $1}' | while read -r lib; do
+    case "$(basename "$lib")" in
+      libcuda.so*) ;;
+      libc.so*|libm.so*|libdl.so*|libpthread.so*|librt.so*|ld-linux*) cp -L "$lib" "$dist/glibc/" ;;
+      *) cp -L "$lib" "$dist/lib/" ;;
+    esac
+  done
+  # What the GPU machine's C library must provide, and the device code's provenance from here.
+  { echo "built on: $(uname -srm); $(ldd --version | head -1)"
+    echo "highest glibc symbol version needed:"
+    for f in "$dist"/bin/* "$dist"/lib/*; do objdump -T "$f" 2>/dev/null; done | grep -o 'GLIBC_[0-9.]*' | sort -Vu | tail -1
+    grep -h 'set(CMAKE_CUDA_COMPILER_VERSION' build-gpu/CMakeFiles/*/CMakeCUDACompiler.cmake 2>/dev/null | head -1
+    grep -h '^CUDA_FLAGS' build-gpu/variants/CMakeFiles/demmat_variant_cuda.dir/flags.make || echo "no cuda variant in this build"
+  } > "$dist/build-info.txt"
+  # The device code's arithmetic, checked here (cuobjdump is not on this machine): the PTX of cuda.cu
+  # with the build's flags has no fused multiply-add, and every f64 add, mul, div and sqrt rounds to nearest.
+  nvcc="$(sed -n 's/^set(CMAKE_CUDA_COMPILER "\(.*\)")$/\1/p' build-gpu/CMakeFiles/*/CMakeCUDACompiler.cmake | head -1)"
+  if [[ -n "$nvcc" ]]; then
+    flags="$(grep -h '^CUDA_FLAGS' build-gpu/variants/CMakeFiles/demmat_variant_cuda.dir/flags.make | cut -d= -f2- | sed 's/--generate-code=[^ ]*//g')"
+    incs="$(grep -h '^CUDA_INCLUDES' build-gpu/variants/CMakeFiles/demmat_variant_cuda.dir/flags.make | cut -d= -f2-)"
+    # shellcheck disable=SC2086
+    (cd build-gpu/variants && "$nvcc" $incs $flags -arch=compute_90 --ptx "$OLDPWD/variants/cuda/cuda.cu" -o "$OLDPWD/$dist/cuda.ptx")
+    { echo "PTX of variants/cuda/cuda.cu (compute_90):"
+      echo "  kernels (entry points): $(grep -c '\.entry' "$dist/cuda.ptx")"
+      echo "  fma instructions: $(grep -cE '^\s*fma\.' "$dist/cuda.ptx")"
+      echo "  f64 add/sub/mul: $(grep -cE '^\s*(add|sub|mul)\.rn\.f64' "$dist/cuda.ptx") with .rn, $(grep -cE '^\s*(add|sub|mul)\.f64' "$dist/cuda.ptx") without"
+      echo "  f64 div: $(grep -cE '^\s*div\.rn\.f64' "$dist/cuda.ptx") (.rn), $(grep -cE '^\s*div\.(approx|full)' "$dist/cuda.ptx") (approximate)"
+      echo "  f64 sqrt: $(grep -cE '^\s*sqrt\.rn\.f64' "$dist/cuda.ptx") (.rn), $(grep -cE '^\s*sqrt\.approx' "$dist/cuda.ptx") (approximate)"
+    } > "$dist/ptx-check.txt"
+    cat "$dist/ptx-check.txt"
+  fi
+  du -sh "$dist"
+  echo "packed $dist: carry it to the GPU machine and run scripts/device_check.sh there"
+  exit 0
+fi
+
+# ---- on the GPU machine --------------------------------------------------------------------------------
+budget=${BUDGET_S:-450}
+settle_time=${SETTLE_TIME:-0.15}
+sizes=${SIZES:-"10000 100000 1000000"}
+big=${BIG:-10000000}
+start=$SECONDS
+res=${RESULTS:-results/gpu}
+gpu=${VARIANT:-cuda}
+work=$res/work
+mkdir -p "$res" "$work"
+log=$res/log.txt
+: > "$log"
+say() { echo "$*" | tee -a "$log"; }
+left() { echo $((budget - (SECONDS - start))); }
+# run_capped CAP_S CMD...: runs CMD with at most min(CAP_S, time left) seconds; 124 when cut off.
+run_capped() {
+  local cap=$1; shift
+  local l; l=$(left)
+  ((l < cap)) && cap=$l
+  if ((cap < 5)); then say "skipped (no time left): $*"; return 125; fi
+  timeout "$cap" "$@"
+  local rc=$?
+  ((rc == 124)) && say "cut off after ${cap} s: $*"
+  return $rc
+}
+finish() {
+  say "== done in $((SECONDS - start)) s"
+  if [[ -n "${OUT:-}" ]]; then mkdir -p "$OUT/results" && cp -r "$res" "$OUT/results/" && rm -rf "$OUT/results/$(basename "$res")/work"; fi
+}
+trap finish EXIT
+
+bin="$PWD/$dist/bin/demmat"
+[[ -x "$bin" ]] || { say "error: $bin missing: run scripts/device_check.sh --pack on the build machine and carry $dist"; exit 2; }
+# demmat with its libraries; through the carried loader and C library where this machine's glibc is older.
+demmat=(env LD_LIBRARY_PATH="$PWD/$dist/lib" "$bin")
+if ! "${demmat[@]}" list > /dev/null 2> "$res/loader.txt"; then
+  demmat=("$PWD/$dist/glibc/$(basename "$(ls "$dist"/glibc/ld-linux*)")" --library-path "$PWD/$dist/lib:$PWD/$dist/glibc" "$bin")
+  say "the system's loader cannot start demmat ($(head -1 "$res/loader.txt")): using the carried glibc"
+fi
+
+say "== provenance"
+{ date -u; uname -a; nproc; } > "$res/host.txt"
+lscpu >> "$res/host.txt" 2>/dev/null
+nvidia-smi > "$res/nvidia-smi.txt" 2>&1
+nvidia-smi --query-gpu=name,driver_version,compute_cap,memory.total --format=csv 2>&1 | tee -a "$log"
+nvidia-smi -q >> "$res/nvidia-smi.txt" 2>&1
+cp "$dist/build-info.txt" "$dist/ptx-check.txt" "$res/" 2>/dev/null
+if command -v cuobjdump >/dev/null; then
+  cuobjdump --list-elf --list-ptx "$bin" > "$res/cuobjdump.txt" 2>&1
+  cuobjdump -sass "$bin" 2>/dev/null | grep -cE '\bDFMA\b' | sed 's/^/DFMA instructions in the SASS: /' >> "$res/cuobjdump.txt"
+else
+  echo "cuobjdump not on this machine; the PTX check from the build machine is ptx-check.txt" > "$res/cuobjdump.txt"
+fi
+"${demmat[@]}" list | tee "$res/list.txt" | tee -a "$log"
+if ! grep -E "^$gpu " "$res/list.txt" | grep -qv unavailable; then say "error: the $gpu variant cannot run here (see list.txt)"; exit 1; fi
+
+cmp_steps=${CMP_STEPS:-1000}
+say "== bitwise: $gpu against arrays (and a second $gpu run), $cmp_steps steps"
+n=${CMP_N:-2000}
+"${demmat[@]}" scene dense-bed --n "$n" -o "$work/bed_$n.toml"
+run_capped 120 "${demmat[@]}" run "$work/bed_$n.toml" --variant "$gpu" --time "$settle_time" --save "$work/bed_${n}_settled.state" -q \
+  --json "$res/settle_$n.json" >> "$log" 2>&1
+"${demmat[@]}" scene compression --from "$work/bed_$n.toml" --state "$work/bed_${n}_settled.state" --speed 0 -o "$work/bed_${n}_resting.toml"
+"${demmat[@]}" scene compression --from "$work/bed_$n.toml" --state "$work/bed_${n}_settled.state" -o "$work/bed_${n}_compression.toml"
+for s in "bed_$n" "bed_${n}_resting" "bed_${n}_compression"; do
+  run_capped 90 "${demmat[@]}" compare "$work/$s.toml" --variants "$gpu,arrays,$gpu" --steps "$cmp_steps" 2>&1 | tee -a "$log" "$res/compare_$s.txt"
+done
+
+say "== benchmark: us per particle-step, $gpu beside fast at 16 threads and at 1"
+# bench LABEL SCENE STEPS REPS CAP: each configuration alone (its own JSON), so that one cut off loses only itself.
+bench() {
+  for cfg in "$gpu:1" fast:16 fast:1; do
+    local v=${cfg%:*} t=${cfg#*:} f="$res/bench_$1_${cfg/:/_}" k=$3
+    [[ $v == "$gpu" ]] && k=$((k * 10 > 200 ? 200 : k * 10))  # the device's steps are short: more of them
+    run_capped "$5" "${demmat[@]}" bench "$2" --variants "$v" --threads "$t" --steps "$k" --repetitions "$4" --warmup 2 \
+      --json "$f.json" > "$f.txt" 2>> "$log"
+    tee -a "$log" < "$f.txt"
+  done
+}
+for n in $sizes; do
+  "${demmat[@]}" scene dense-bed --n "$n" -o "$work/bed_$n.toml"
+  run_capped 200 "${demmat[@]}" run "$work/bed_$n.toml" --variant "$gpu" --time "$settle_time" --save "$work/bed_${n}_settled.state" -q \
+    --json "$res/settle_$n.json" >> "$log" 2>&1 || continue
+  "${demmat[@]}" scene compression --from "$work/bed_$n.toml" --state "$work/bed_${n}_settled.state" --speed 0 -o "$work/bed_${n}_settled.toml"
+  steps=$((2000000 / n)); ((steps < 3)) && steps=3; ((steps > 200)) && steps=200
+  bench "settled_$n" "$work/bed_${n}_settled.toml" "$steps" 3 150
+done
+if ((big > 0)); then
+  "${demmat[@]}" scene dense-bed --n "$big" -o "$work/loose_$big.toml"
+  bench "loose_$big" "$work/loose_$big.toml" 2 1 200
+fi
