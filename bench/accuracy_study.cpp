@@ -297,7 +297,7 @@ void two_body_study(const Options& opt, std::vector<Row>& rows, json& refs)
         const bool wall = c.oblique;
         const double mstar = wall ? su.mass[0] : su.mass[0] * su.mass[1] / (su.mass[0] + su.mass[1]);
         const double rstar = wall ? r : r / 2.0;
-        const double estar = 0.75 * (wall ? su.contact.hertz_pw : su.contact.hertz_pp);
+        const double estar = wall ? su.contact.estar_pw() : su.contact.estar_pp();
         const double vn = wall ? -st.trans.v[0].z : st.trans.v[0].x - st.trans.v[1].x;
         const double tc = hertz_tc(mstar, rstar, estar, vn);
         const double gap = -c.impact.normal({0.0, st.trans.x, st.trans.v, st.rot.v}).h;

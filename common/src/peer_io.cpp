@@ -84,7 +84,7 @@ std::string data_file(const Scene& scene, const State& s)
     return out;
 }
 
-double e_star_pw(const Scene& scene) { return scene.contact_params().hertz_pw * 0.75; }
+double e_star_pw(const Scene& scene) { return scene.contact_params().estar_pw(); }
 
 std::string lammps_fragment(const Scene& scene, const State& s, const PeerOptions& o, double skin)
 {

@@ -51,9 +51,9 @@ ContactTime shortest_contact_time(const Scene& scene, const State& state, double
     const double m = sphere_mass(rmin, scene.material.density);
     const ContactParams<double> p = scene.contact_params();
     out.tc = INFINITY;
-    if (state.size() > 1) out.tc = hertz_contact_time(m / 2.0, rmin / 2.0, 0.75 * p.hertz_pp, speed);
+    if (state.size() > 1) out.tc = hertz_contact_time(m / 2.0, rmin / 2.0, p.estar_pp(), speed);
     if (!state.walls.empty()) {
-        const double tw = hertz_contact_time(m, rmin, 0.75 * p.hertz_pw, speed);
+        const double tw = hertz_contact_time(m, rmin, p.estar_pw(), speed);
         if (tw < out.tc) {
             out.tc = tw;
             out.wall = true;
