@@ -21,6 +21,7 @@
 #include "demmat/registry.hpp"
 #include "demmat/text.hpp"
 #include "demmat/scenes.hpp"
+#include "demmat/stability.hpp"
 #include "demmat/threads.hpp"
 #include "peer_commands.hpp"
 

@@ -121,4 +121,21 @@ double elastic_energy(const std::vector<Vec3d>& x, const std::vector<double>& ra
     return e;
 }
 
+std::string check_time_step(const Scene& scene, const State& state)
+{
+    double rmin = state.radius.front();
+    for (double r : state.radius) rmin = std::min(rmin, r);
+    const double tr = rayleigh_time(scene.material, rmin);
+    if (scene.dt > tr)
+        throw Error(fmt::format("{}: time step {:g} s exceeds the Rayleigh time {:.3g} s of the smallest particle (R = {:g} m): "
+                                "the run would be unstable; use dt <= {:.3g} s", scene.name, scene.dt, tr, rmin, 0.2 * tr));
+    // The Hertz contact time at the scene's largest impact speed (stability.hpp, docs/stability.md): refused
+    // above the integrator's measured stability limit, a warning above kWarnFractionOfContactTime of it.
+    const std::string hertz = check_contact_time_step(scene, state);
+    if (scene.dt > 0.2 * tr)
+        return fmt::format("time step {:g} s is {:.2f} of the Rayleigh time {:.3g} s; above 0.2 of it a run may be inaccurate or unstable{}{}",
+                           scene.dt, scene.dt / tr, tr, hertz.empty() ? "" : "; ", hertz);
+    return hertz;
+}
+
 } // namespace demmat

@@ -9,7 +9,6 @@
 #include "demmat/error.hpp"
 #include "demmat/io.hpp"
 #include "demmat/reference.hpp"
-#include "demmat/stability.hpp"
 
 namespace demmat {
 
@@ -317,23 +316,4 @@ State initial_state(const Scene& scene)
     return s;
 }
 
-} // namespace demmat
-
-namespace demmat {
-std::string check_time_step(const Scene& scene, const State& state)
-{
-    double rmin = state.radius.front();
-    for (double r : state.radius) rmin = std::min(rmin, r);
-    const double tr = rayleigh_time(scene.material, rmin);
-    if (scene.dt > tr)
-        throw Error(fmt::format("{}: time step {:g} s exceeds the Rayleigh time {:.3g} s of the smallest particle (R = {:g} m): "
-                                "the run would be unstable; use dt <= {:.3g} s", scene.name, scene.dt, tr, rmin, 0.2 * tr));
-    // The Hertz contact time at the scene's largest impact speed (stability.hpp, docs/stability.md): refused
-    // above the integrator's measured stability limit, a warning above kWarnFractionOfContactTime of it.
-    const std::string hertz = check_contact_time_step(scene, state);
-    if (scene.dt > 0.2 * tr)
-        return fmt::format("time step {:g} s is {:.2f} of the Rayleigh time {:.3g} s; above 0.2 of it a run may be inaccurate or unstable{}{}",
-                           scene.dt, scene.dt / tr, tr, hertz.empty() ? "" : "; ", hertz);
-    return hertz;
-}
 } // namespace demmat

@@ -42,6 +42,11 @@ double stable_fraction_of_contact_time(Integrator scheme);
 // by more than about 1 % for the paper's Gear scheme (docs/stability.md).
 inline constexpr double kWarnFractionOfContactTime = 0.05;
 
+// Refuses a time step above the Rayleigh time of the smallest particle (a scene that cannot be stable)
+// and returns a warning (empty if none) when Δt exceeds 0.2 of it, the usual rule of thumb; likewise for
+// the Hertz contact time at the scene's largest impact speed (check_contact_time_step, below).
+std::string check_time_step(const Scene& scene, const State& state);
+
 // Refuses (throws Error, one line) a Δt above the scene's integrator's stability limit in units of the
 // shortest contact time at the largest impact speed; returns a warning (empty if none) above
 // kWarnFractionOfContactTime of it.

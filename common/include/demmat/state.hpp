@@ -68,10 +68,3 @@ State initial_state(const Scene& scene);
 void initial_accelerations(const Scene& scene, State& state);
 
 } // namespace demmat
-
-namespace demmat {
-// Refuses a time step above the Rayleigh time of the smallest particle (a scene that cannot be stable)
-// and returns a warning (empty if none) when Δt exceeds 0.2 of it, the usual rule of thumb; likewise for
-// the Hertz contact time at the scene's largest impact speed (check_contact_time_step, stability.hpp).
-std::string check_time_step(const Scene& scene, const State& state);
-} // namespace demmat
