@@ -160,7 +160,8 @@ def main():
     except (OSError, ValueError) as e:
         sys.exit(f"plot_features.py: cannot read {a.bench}: {e}")
     t = table(samples(bench))
-    ctx = bench.get("context", {})
+    # demmat's provenance block as demmat_* keys beside the run's context (older files carry those strings)
+    ctx = {**bench.get("context", {}), **{"demmat_" + k: v for k, v in bench.get("provenance", {}).items()}}
     text = markdown(t, ctx)
     write_text(a.markdown, text)
     if a.table:

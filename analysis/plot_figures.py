@@ -68,13 +68,14 @@ def load(path):
     if "particles" in df:
         df["particles"] = df["particles"].astype("Int64")  # a count: printed without a decimal point
     prov = {k[len("demmat_"):]: v for k, v in ctx.items() if k.startswith("demmat_")}
+    prov.update(raw.get("provenance", {}))  # demmat's provenance block (older files: demmat_* strings)
     prov["host_cpus"] = ctx.get("num_cpus")
     prov["mhz_per_cpu"] = ctx.get("mhz_per_cpu")
     return df, prov
 
 
 def caption(prov, extra=""):
-    dirty = " (dirty)" if str(prov.get("dirty")) == "true" else ""
+    dirty = " (dirty)" if prov.get("dirty") in (True, "true") else ""
     return (f"{prov.get('cpu', '?')}, {prov.get('host_cpus', '?')} CPUs · {prov.get('compiler', '?')} {prov.get('flags', '')} · "
             f"commit {str(prov.get('commit', '?'))[:10]}{dirty} · {prov.get('date', '')} · {prov.get('sweep', '')} sweep{extra}")
 

@@ -33,6 +33,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "benchmark_provenance.hpp"
 #include "demmat/driver.hpp"
 #include "demmat/error.hpp"
 #include "demmat/features.hpp"
@@ -234,6 +235,7 @@ int main(int argc, char** argv)
         std::cerr << "bench_features: " << e.what() << "\n";
         return 2;
     }
+    const std::string json_out = benchmark_json_out(argc, argv);
     benchmark::Initialize(&argc, argv);
     if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
     try {
@@ -253,11 +255,15 @@ int main(int argc, char** argv)
                     [variant, l = level.get(), full](benchmark::State& st) { run_level(st, variant, *l, full); })
                     ->Unit(benchmark::kMillisecond)
                     ->Iterations(opt.steps);
-    const auto p = provenance_json();
-    for (const auto& [k, v] : p.items()) benchmark::AddCustomContext("demmat_" + k, v.is_string() ? v.get<std::string>() : v.dump());
     benchmark::AddCustomContext("demmat_settle_time_s", fmt::format("{}", kSettleTime));
     benchmark::AddCustomContext("demmat_warmup_steps", fmt::format("{}", kWarmup));
     benchmark::RunSpecifiedBenchmarks();
     benchmark::Shutdown();
+    try {
+        add_provenance(json_out);
+    } catch (const Error& e) {
+        std::cerr << "bench_features: " << e.what() << "\n";
+        return 1;
+    }
     return 0;
 }

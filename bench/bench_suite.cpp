@@ -32,6 +32,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "benchmark_provenance.hpp"
 #include "demmat/driver.hpp"
 #include "demmat/error.hpp"
 #include "demmat/output.hpp"
@@ -396,14 +397,13 @@ int main(int argc, char** argv)
     }
     bool filtered = false;
     for (int i = 1; i < argc; ++i) filtered = filtered || std::strncmp(argv[i], "--benchmark_filter=", 19) == 0;
+    const std::string json_out = benchmark_json_out(argc, argv);
     benchmark::Initialize(&argc, argv);
     if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
     if (opt.families.count("stream")) register_stream();
     if (opt.families.count("figure4")) register_figure4();
     if (opt.families.count("cellsize")) register_cellsize();
     if (opt.families.count("phases")) register_phases();
-    const auto p = provenance_json();
-    for (const auto& [k, v] : p.items()) benchmark::AddCustomContext("demmat_" + k, v.is_string() ? v.get<std::string>() : v.dump());
     benchmark::AddCustomContext("demmat_sweep", opt.full ? "full" : "short");
     benchmark::AddCustomContext("demmat_settle_time_s", fmt::format("{}", settle_time));
     try {
@@ -412,10 +412,11 @@ int main(int argc, char** argv)
         if (!filtered)
             for (std::int64_t n : beds_to_settle) ensure_settled(n);
         benchmark::RunSpecifiedBenchmarks();
+        benchmark::Shutdown();
+        add_provenance(json_out);
     } catch (const Error& e) {
         std::cerr << "demmat_bench: " << e.what() << "\n";
         return 1;
     }
-    benchmark::Shutdown();
     return 0;
 }
