@@ -4,8 +4,9 @@ One loader for every schema, so that no script parses a result file of its own:
   demmat bench --json   (app/main.cpp cmd_bench)        kind "bench"
   demmat run --json     (app/main.cpp cmd_run)          kind "run"
   Google Benchmark JSON (bench/bench_suite.cpp, bench/bench_features.cpp): the label of each benchmark is
-                        a JSON object, its counters the measurements; provenance in the context as
-                        demmat_* strings ("dirty": "false")                          kind "gbench"
+                        a JSON object, its counters the measurements; provenance as a "provenance"
+                        block at the top (older files: demmat_* strings in the context, "dirty": "false")
+                                                                                     kind "gbench"
   results/peers/bench_peers.json (analysis/plot_peers.py bench)                      kind "peers"
   demmat_stability JSON (bench/stability_study.cpp)                                 kind "stability"
   demmat_accuracy JSON + the CSV beside it (bench/accuracy_study.cpp)                kind "accuracy"
@@ -138,7 +139,10 @@ _DERIVED = {"total_s", "search_plus_forces_s"}
 
 def _gbench(path, raw):
     ctx = raw["context"]
-    prov = normalise_provenance({k[len("demmat_"):]: v for k, v in ctx.items() if k.startswith("demmat_")}, ctx)
+    # The run's own keys (sweep, settle time) as demmat_* strings in the context; the provenance block at
+    # the top (older files: demmat_* strings in the context too).
+    prov = normalise_provenance({**{k[len("demmat_"):]: v for k, v in ctx.items() if k.startswith("demmat_")},
+                                 **raw.get("provenance", {})}, ctx)
     rows = []
     for b in raw["benchmarks"]:
         if b.get("run_type") != "iteration" or not b.get("label") or b.get("error_occurred"):

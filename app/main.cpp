@@ -26,6 +26,7 @@
 #include "demmat/run_log.hpp"
 #include "demmat/text.hpp"
 #include "demmat/scenes.hpp"
+#include "demmat/stability.hpp"
 #include "demmat/threads.hpp"
 #include "cli_ranges.hpp"
 #include "peer_commands.hpp"

@@ -33,6 +33,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "benchmark_common.hpp"
 #include "demmat/driver.hpp"
 #include "demmat/error.hpp"
 #include "demmat/features.hpp"
@@ -192,48 +193,37 @@ void run_level(benchmark::State& st, const std::string& variant, const Level& le
     st.SetLabel(label.dump());
 }
 
-void parse_own_options(int& argc, char** argv)
+// One of the program's own options (take_own_options); false for any other argument.
+bool own_option(std::string_view key, const char* v)
 {
-    int out = 1;
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        auto value = [&](const char* key) -> const char* {
-            const std::size_t l = std::strlen(key);
-            return a.compare(0, l, key) == 0 ? argv[i] + l : nullptr;
-        };
-        auto count = [&](const char* key, const char* v) {
-            char* end = nullptr;
-            const long long x = std::strtoll(v, &end, 10);
-            if (end == v || *end != '\0' || x <= 0) throw Error(fmt::format("{} needs a positive integer, not '{}'", key, v));
-            return std::int64_t(x);
-        };
-        if (const char* v = value("--n=")) {
-            opt.n = count("--n", v);
-        } else if (const char* v = value("--steps=")) {
-            opt.steps = count("--steps", v);
-        } else if (const char* v = value("--states-dir=")) {
-            opt.states_dir = v;
-        } else if (const char* v = value("--variants=")) {
-            opt.variants.clear();
-            for (const std::string& name : split_list(v)) opt.variants.push_back(registry().find(name).name);  // throws naming the known variants
-            if (opt.variants.empty()) throw Error("--variants names no variant");
-        } else {
-            argv[out++] = argv[i];
-        }
+    auto count = [&](const char* v) {
+        char* end = nullptr;
+        const long long x = std::strtoll(v, &end, 10);
+        if (end == v || *end != '\0' || x <= 0) throw Error(fmt::format("{} needs a positive integer, not '{}'", key, v));
+        return std::int64_t(x);
+    };
+    if (key == "--n") {
+        opt.n = count(v);
+    } else if (key == "--steps") {
+        opt.steps = count(v);
+    } else if (key == "--states-dir") {
+        opt.states_dir = v;
+    } else if (key == "--variants") {
+        opt.variants.clear();
+        for (const std::string& name : split_list(v)) opt.variants.push_back(registry().find(name).name);  // throws naming the known variants
+        if (opt.variants.empty()) throw Error("--variants names no variant");
+    } else {
+        return false;
     }
-    argc = out;
+    return true;
 }
 
 } // namespace
 
 int main(int argc, char** argv)
 {
-    try {
-        parse_own_options(argc, argv);
-    } catch (const Error& e) {
-        std::cerr << "bench_features: " << e.what() << "\n";
-        return 2;
-    }
+    if (!take_own_options(argc, argv, "bench_features", own_option)) return 2;
+    const std::string json_out = benchmark_json_out(argc, argv);
     benchmark::Initialize(&argc, argv);
     if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
     try {
@@ -253,11 +243,15 @@ int main(int argc, char** argv)
                     [variant, l = level.get(), full](benchmark::State& st) { run_level(st, variant, *l, full); })
                     ->Unit(benchmark::kMillisecond)
                     ->Iterations(opt.steps);
-    const auto p = provenance_json();
-    for (const auto& [k, v] : p.items()) benchmark::AddCustomContext("demmat_" + k, v.is_string() ? v.get<std::string>() : v.dump());
     benchmark::AddCustomContext("demmat_settle_time_s", fmt::format("{}", kSettleTime));
     benchmark::AddCustomContext("demmat_warmup_steps", fmt::format("{}", kWarmup));
     benchmark::RunSpecifiedBenchmarks();
     benchmark::Shutdown();
+    try {
+        add_provenance(json_out);
+    } catch (const Error& e) {
+        std::cerr << "bench_features: " << e.what() << "\n";
+        return 1;
+    }
     return 0;
 }

@@ -32,6 +32,7 @@
 #include <fmt/format.h>
 #include <nlohmann/json.hpp>
 
+#include "benchmark_common.hpp"
 #include "demmat/driver.hpp"
 #include "demmat/error.hpp"
 #include "demmat/output.hpp"
@@ -353,57 +354,43 @@ void register_stream()
         }
 }
 
-// Removes the suite's own options from argv (Google Benchmark rejects what it does not know).
-void parse_own_options(int& argc, char** argv)
+// One of the suite's own options (take_own_options); false for any other argument.
+bool own_option(std::string_view key, const char* v)
 {
-    int out = 1;
-    for (int i = 1; i < argc; ++i) {
-        const std::string a = argv[i];
-        auto value = [&](const char* key) -> const char* {
-            const std::size_t l = std::strlen(key);
-            return a.compare(0, l, key) == 0 ? argv[i] + l : nullptr;
-        };
-        if (const char* v = value("--sweep=")) {
-            if (std::strcmp(v, "full") != 0 && std::strcmp(v, "short") != 0)
-                throw Error(fmt::format("--sweep must be 'short' or 'full', not '{}'", v));
-            opt.full = std::strcmp(v, "full") == 0;
-        } else if (const char* v = value("--states-dir=")) {
-            opt.states_dir = v;
-        } else if (const char* v = value("--families=")) {
-            opt.families.clear();
-            for (const std::string& family : split_list(v)) {
-                if (family != "phases" && family != "figure4" && family != "cellsize" && family != "stream")
-                    throw Error(fmt::format("unknown family '{}' in --families (known: phases, figure4, cellsize, stream)", family));
-                opt.families.insert(family);
-            }
-            if (opt.families.empty()) throw Error("--families names no family (known: phases, figure4, cellsize, stream)");
-        } else {
-            argv[out++] = argv[i];
+    if (key == "--sweep") {
+        if (std::strcmp(v, "full") != 0 && std::strcmp(v, "short") != 0)
+            throw Error(fmt::format("--sweep must be 'short' or 'full', not '{}'", v));
+        opt.full = std::strcmp(v, "full") == 0;
+    } else if (key == "--states-dir") {
+        opt.states_dir = v;
+    } else if (key == "--families") {
+        opt.families.clear();
+        for (const std::string& family : split_list(v)) {
+            if (family != "phases" && family != "figure4" && family != "cellsize" && family != "stream")
+                throw Error(fmt::format("unknown family '{}' in --families (known: phases, figure4, cellsize, stream)", family));
+            opt.families.insert(family);
         }
+        if (opt.families.empty()) throw Error("--families names no family (known: phases, figure4, cellsize, stream)");
+    } else {
+        return false;
     }
-    argc = out;
+    return true;
 }
 
 } // namespace
 
 int main(int argc, char** argv)
 {
-    try {
-        parse_own_options(argc, argv);
-    } catch (const Error& e) {
-        std::cerr << "demmat_bench: " << e.what() << "\n";
-        return 2;
-    }
+    if (!take_own_options(argc, argv, "demmat_bench", own_option)) return 2;
     bool filtered = false;
     for (int i = 1; i < argc; ++i) filtered = filtered || std::strncmp(argv[i], "--benchmark_filter=", 19) == 0;
+    const std::string json_out = benchmark_json_out(argc, argv);
     benchmark::Initialize(&argc, argv);
     if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
     if (opt.families.count("stream")) register_stream();
     if (opt.families.count("figure4")) register_figure4();
     if (opt.families.count("cellsize")) register_cellsize();
     if (opt.families.count("phases")) register_phases();
-    const auto p = provenance_json();
-    for (const auto& [k, v] : p.items()) benchmark::AddCustomContext("demmat_" + k, v.is_string() ? v.get<std::string>() : v.dump());
     benchmark::AddCustomContext("demmat_sweep", opt.full ? "full" : "short");
     benchmark::AddCustomContext("demmat_settle_time_s", fmt::format("{}", settle_time));
     try {
@@ -412,10 +399,11 @@ int main(int argc, char** argv)
         if (!filtered)
             for (std::int64_t n : beds_to_settle) ensure_settled(n);
         benchmark::RunSpecifiedBenchmarks();
+        benchmark::Shutdown();
+        add_provenance(json_out);
     } catch (const Error& e) {
         std::cerr << "demmat_bench: " << e.what() << "\n";
         return 1;
     }
-    benchmark::Shutdown();
     return 0;
 }

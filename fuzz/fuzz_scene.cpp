@@ -6,6 +6,7 @@
 #include <string>
 
 #include "demmat/scene.hpp"
+#include "demmat/stability.hpp"
 #include "demmat/state.hpp"
 #include "fuzz_common.hpp"
 

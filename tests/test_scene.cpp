@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "demmat/error.hpp"
+#include "demmat/stability.hpp"
 #include "support.hpp"
 
 using namespace demmat;

@@ -20,15 +20,26 @@ double hertz_contact_time(double mstar, double rstar, double estar, double speed
     return 2.87 * std::pow(mstar * mstar / (rstar * estar * estar * speed), 0.2);
 }
 
-double impact_speed_bound(const Scene& scene, const State& state)
+double fastest_wall_speed(const State& state)
 {
-    double v0 = 0.0, vw = 0.0;
-    for (const Vec3d& v : state.trans.v) v0 = std::max(v0, std::sqrt(dot(v, v)));
+    double vw = 0.0;
     for (const Wall& w : state.walls) vw = std::max(vw, std::sqrt(dot(w.velocity, w.velocity)));
+    return vw;
+}
+
+double explained_speed(const Scene& scene, const State& state)
+{
+    double v0 = 0.0;
+    for (const Vec3d& v : state.trans.v) v0 = std::max(v0, std::sqrt(dot(v, v)));
     const Vec3d ext = scene.domain.max - scene.domain.min;
     const double fall = std::sqrt(2.0 * std::sqrt(dot(scene.gravity, scene.gravity)) * std::sqrt(dot(ext, ext)));
-    const double vp = v0 + fall + vw;
-    return state.size() > 1 ? 2.0 * vp : vp + vw;
+    return v0 + fall + fastest_wall_speed(state);
+}
+
+double impact_speed_bound(const Scene& scene, const State& state)
+{
+    const double vp = explained_speed(scene, state);
+    return state.size() > 1 ? 2.0 * vp : vp + fastest_wall_speed(state);
 }
 
 ContactTime shortest_contact_time(const Scene& scene, const State& state, double speed)
@@ -40,9 +51,9 @@ ContactTime shortest_contact_time(const Scene& scene, const State& state, double
     const double m = sphere_mass(rmin, scene.material.density);
     const ContactParams<double> p = scene.contact_params();
     out.tc = INFINITY;
-    if (state.size() > 1) out.tc = hertz_contact_time(m / 2.0, rmin / 2.0, 0.75 * p.hertz_pp, speed);
+    if (state.size() > 1) out.tc = hertz_contact_time(m / 2.0, rmin / 2.0, p.estar_pp(), speed);
     if (!state.walls.empty()) {
-        const double tw = hertz_contact_time(m, rmin, 0.75 * p.hertz_pw, speed);
+        const double tw = hertz_contact_time(m, rmin, p.estar_pw(), speed);
         if (tw < out.tc) {
             out.tc = tw;
             out.wall = true;
@@ -108,6 +119,23 @@ double elastic_energy(const std::vector<Vec3d>& x, const std::vector<double>& ra
         }
     }
     return e;
+}
+
+std::string check_time_step(const Scene& scene, const State& state)
+{
+    double rmin = state.radius.front();
+    for (double r : state.radius) rmin = std::min(rmin, r);
+    const double tr = rayleigh_time(scene.material, rmin);
+    if (scene.dt > tr)
+        throw Error(fmt::format("{}: time step {:g} s exceeds the Rayleigh time {:.3g} s of the smallest particle (R = {:g} m): "
+                                "the run would be unstable; use dt <= {:.3g} s", scene.name, scene.dt, tr, rmin, 0.2 * tr));
+    // The Hertz contact time at the scene's largest impact speed (stability.hpp, docs/stability.md): refused
+    // above the integrator's measured stability limit, a warning above kWarnFractionOfContactTime of it.
+    const std::string hertz = check_contact_time_step(scene, state);
+    if (scene.dt > 0.2 * tr)
+        return fmt::format("time step {:g} s is {:.2f} of the Rayleigh time {:.3g} s; above 0.2 of it a run may be inaccurate or unstable{}{}",
+                           scene.dt, scene.dt / tr, tr, hertz.empty() ? "" : "; ", hertz);
+    return hertz;
 }
 
 } // namespace demmat

@@ -9,7 +9,6 @@
 #include "demmat/error.hpp"
 #include "demmat/io.hpp"
 #include "demmat/reference.hpp"
-#include "demmat/stability.hpp"
 
 namespace demmat {
 
@@ -269,6 +268,20 @@ State parse_state(const std::string& bytes, const std::string& label)
     return s;
 }
 
+void initial_accelerations(const Scene& scene, State& s)
+{
+    std::vector<double> mass(s.size());
+    for (std::size_t i = 0; i < s.size(); ++i) mass[i] = sphere_mass(s.radius[i], scene.material.density);
+    std::vector<Vec3d> f, t;
+    reference_forces(s.trans.x, s.trans.v, s.rot.v, s.radius, mass, s.walls, s.step, scene.dt, scene.contact_params(), f, t);
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        const double inertia = sphere_inertia(s.radius[i], mass[i]);
+        s.trans.a[i] = {acceleration(f[i].x, mass[i], scene.gravity.x), acceleration(f[i].y, mass[i], scene.gravity.y),
+                        acceleration(f[i].z, mass[i], scene.gravity.z)};
+        s.rot.a[i] = {t[i].x / inertia, t[i].y / inertia, t[i].z / inertia};
+    }
+}
+
 State initial_state(const Scene& scene)
 {
     State s;
@@ -298,37 +311,8 @@ State initial_state(const Scene& scene)
     s.fingerprint = scene.fingerprint(s.size());
     validate_new_particles(scene, s);
 
-    // t = 0: a = F(x, v)/m + g, α = T/I; b3 = b4 = b5 = 0.
-    std::vector<double> mass(s.size());
-    for (std::size_t i = 0; i < s.size(); ++i) mass[i] = sphere_mass(s.radius[i], scene.material.density);
-    std::vector<Vec3d> f, t;
-    reference_forces(s.trans.x, s.trans.v, s.rot.v, s.radius, mass, s.walls, s.step, scene.dt, scene.contact_params(), f, t);
-    for (std::size_t i = 0; i < s.size(); ++i) {
-        const double inertia = sphere_inertia(s.radius[i], mass[i]);
-        s.trans.a[i] = {acceleration(f[i].x, mass[i], scene.gravity.x), acceleration(f[i].y, mass[i], scene.gravity.y),
-                        acceleration(f[i].z, mass[i], scene.gravity.z)};
-        s.rot.a[i] = {t[i].x / inertia, t[i].y / inertia, t[i].z / inertia};
-    }
+    initial_accelerations(scene, s);  // t = 0; b3 = b4 = b5 = 0 as resized
     return s;
 }
 
-} // namespace demmat
-
-namespace demmat {
-std::string check_time_step(const Scene& scene, const State& state)
-{
-    double rmin = state.radius.front();
-    for (double r : state.radius) rmin = std::min(rmin, r);
-    const double tr = rayleigh_time(scene.material, rmin);
-    if (scene.dt > tr)
-        throw Error(fmt::format("{}: time step {:g} s exceeds the Rayleigh time {:.3g} s of the smallest particle (R = {:g} m): "
-                                "the run would be unstable; use dt <= {:.3g} s", scene.name, scene.dt, tr, rmin, 0.2 * tr));
-    // The Hertz contact time at the scene's largest impact speed (stability.hpp, docs/stability.md): refused
-    // above the integrator's measured stability limit, a warning above kWarnFractionOfContactTime of it.
-    const std::string hertz = check_contact_time_step(scene, state);
-    if (scene.dt > 0.2 * tr)
-        return fmt::format("time step {:g} s is {:.2f} of the Rayleigh time {:.3g} s; above 0.2 of it a run may be inaccurate or unstable{}{}",
-                           scene.dt, scene.dt / tr, tr, hertz.empty() ? "" : "; ", hertz);
-    return hertz;
-}
 } // namespace demmat

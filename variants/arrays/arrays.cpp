@@ -1,7 +1,7 @@
 // The plain-arrays processor, the paper's DEMMAT_F90 in C++: procedural free functions over flat
 // arrays of shape (N, 3) stored column by column (x(i, c) at x[c·N + i], as Fortran stores them),
 // capacities fixed up front and checked (the paper's "control of overestimation"). The particles'
-// state and its phases are in column_state.hpp; this file holds the contact store and the search.
+// state and its phases are in demmat/column_state.hpp; this file holds the contact store and the search.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -9,7 +9,7 @@
 
 #include <fmt/format.h>
 
-#include "column_state.hpp"
+#include "demmat/column_state.hpp"
 #include "demmat/error.hpp"
 #include "demmat/features.hpp"
 #include "demmat/linked_cells.hpp"
@@ -101,7 +101,10 @@ void search_walls(const ColumnState<T, M, S>& s, BoundaryList& bl)
 
 // T: value type (double, float); M: model (model.hpp); S: integrator (integrators.hpp).
 template <class T, class M, class S = Gear5Scheme>
-class ArraysVariant final : public Variant {
+class ArraysVariant final : public ColumnStateVariant<T, M, S> {
+    using ColumnStateVariant<T, M, S>::state_, ColumnStateVariant<T, M, S>::pp_, ColumnStateVariant<T, M, S>::pw_,
+        ColumnStateVariant<T, M, S>::candidates_;
+
 public:
     void init(const Setup& setup) override
     {
@@ -119,8 +122,6 @@ public:
         }
         cells_.reserve(n);
     }
-
-    void predict(std::int64_t step) override { state_.predict(step); }
 
     void search() override
     {
@@ -152,12 +153,6 @@ public:
         state_.newton();
     }
 
-    void correct() override { state_.correct(); }
-    void snapshot(Snapshot& out) const override { state_.snapshot(out); }
-    void save(State& out) const override { state_.save(out); }
-    ContactCounts counts() const override { return {pp_, pw_, candidates_}; }
-    ModelFeatures model() const override { return ModelFeatures::of<M>(); }
-
     std::size_t memory_bytes() const override
     {
         return state_.memory_bytes() + (nl_.partner.size() + nl_.count.size() + bl_.wall.size() + bl_.count.size()) * sizeof(Index) +
@@ -165,12 +160,10 @@ public:
     }
 
 private:
-    ColumnState<T, M, S> state_;
     T cell_ = T(0);
     NeighbourList nl_;
     BoundaryList bl_;
     LinkedCells cells_;
-    std::int64_t pp_ = 0, pw_ = 0, candidates_ = 0;
 };
 
 // The instantiation a run gets, picked in init(): the smallest model that covers what the scene needs

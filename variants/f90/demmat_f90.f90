@@ -99,7 +99,7 @@ module demmat_f90
     real(dp) :: cell = 0.0_dp
     ! Gear coefficients and contact parameters (from C++)
     real(dp) :: dt, half_dt2, two_over_dt2, cx, cv, c3, c4, c5
-    real(dp) :: hertz_pp, hertz_pw, gamma_n, gamma_t, mu
+    real(dp) :: hertz_pp, hertz_pw, gamma_n, gamma_t, mu, margin
     real(dp) :: g(3)
     ! state, (N, 3) each
     real(dp), allocatable :: x(:,:), v(:,:), a(:,:), b3(:,:), b4(:,:), b5(:,:)
@@ -138,21 +138,21 @@ contains
     row(k + 1) = j
   end subroutine insert_ascending
 
-  ! may_touch on scalars (contact_law.hpp): d2 < s*s*1.000000001.
-  pure logical function may_touch_s(xi1, xi2, xi3, xj1, xj2, xj3, ri, rj)
-    real(dp), intent(in) :: xi1, xi2, xi3, xj1, xj2, xj3, ri, rj
+  ! may_touch on scalars (contact_law.hpp): d2 < s*s*margin, the margin from C++ (kMayTouchMargin).
+  pure logical function may_touch_s(xi1, xi2, xi3, xj1, xj2, xj3, ri, rj, margin)
+    real(dp), intent(in) :: xi1, xi2, xi3, xj1, xj2, xj3, ri, rj, margin
     real(dp) :: dx1, dx2, dx3, d2, s
     dx1 = xj1 - xi1
     dx2 = xj2 - xi2
     dx3 = xj3 - xi3
     d2 = (dx1*dx1 + dx2*dx2) + dx3*dx3
     s = ri + rj
-    may_touch_s = d2 < (s*s)*1.000000001_dp
+    may_touch_s = d2 < (s*s)*margin
   end function may_touch_s
 
-  subroutine scan_cells(n, x, r, cap, head, next, cellidx, off, ncount, partner, worst, worst_i)
+  subroutine scan_cells(n, x, r, margin, cap, head, next, cellidx, off, ncount, partner, worst, worst_i)
     integer, intent(in) :: n, cap
-    real(dp), intent(in) :: x(n, 3), r(n)
+    real(dp), intent(in) :: x(n, 3), r(n), margin
     integer, intent(in) :: head(0:), next(n)
     integer(i8), intent(in) :: cellidx(n), off(27)
     integer, intent(out) :: ncount(n)
@@ -167,7 +167,7 @@ contains
         j = head(cellidx(i) + off(k))
         do while (j > 0)
           if (j > i) then
-            if (may_touch_s(xi1, xi2, xi3, x(j, 1), x(j, 2), x(j, 3), ri, r(j))) then
+            if (may_touch_s(xi1, xi2, xi3, x(j, 1), x(j, 2), x(j, 3), ri, r(j), margin)) then
               if (c < cap) call insert_ascending(partner(:, i), c, j)
               c = c + 1
             end if
@@ -182,9 +182,9 @@ contains
     end do
   end subroutine scan_cells
 
-  subroutine scan_all_pairs(n, x, r, cap, ncount, partner, worst, worst_i)
+  subroutine scan_all_pairs(n, x, r, margin, cap, ncount, partner, worst, worst_i)
     integer, intent(in) :: n, cap
-    real(dp), intent(in) :: x(n, 3), r(n)
+    real(dp), intent(in) :: x(n, 3), r(n), margin
     integer, intent(out) :: ncount(n)
     integer, intent(inout) :: partner(:, :)
     integer(i8), intent(inout) :: worst, worst_i
@@ -192,7 +192,7 @@ contains
     do i = 1, n
       c = 0
       do j = i + 1, n
-        if (.not. may_touch_s(x(i, 1), x(i, 2), x(i, 3), x(j, 1), x(j, 2), x(j, 3), r(i), r(j))) cycle
+        if (.not. may_touch_s(x(i, 1), x(i, 2), x(i, 3), x(j, 1), x(j, 2), x(j, 3), r(i), r(j), margin)) cycle
         if (c < cap) partner(c + 1, i) = j
         c = c + 1
       end do
@@ -260,9 +260,9 @@ contains
     end if
 
     if (direct) then
-      call scan_cells(n, p%x, p%r, p%cap, p%head, p%next, p%cellidx, off, p%ncount, p%partner, worst, worst_i)
+      call scan_cells(n, p%x, p%r, p%margin, p%cap, p%head, p%next, p%cellidx, off, p%ncount, p%partner, worst, worst_i)
     else
-      call scan_all_pairs(n, p%x, p%r, p%cap, p%ncount, p%partner, worst, worst_i)
+      call scan_all_pairs(n, p%x, p%r, p%margin, p%cap, p%ncount, p%partner, worst, worst_i)
     end if
     if (worst > p%cap) status = ST_PAIR_CAP
   end subroutine search_pairs
@@ -276,7 +276,7 @@ contains
     p%wcount = 0
     do iw = 1, p%nw
       do i = 1, p%n
-        if (.not. (dot(p%x(i, :) - p%wp(:, iw), p%wn(:, iw)) < p%r(i)*1.000000001_dp)) cycle
+        if (.not. (dot(p%x(i, :) - p%wp(:, iw), p%wn(:, iw)) < p%r(i)*p%margin)) cycle
         if (p%wcount(i) == p%wcap) then
           status = ST_WALL_CAP; bad_i = i - 1
           return
@@ -310,20 +310,21 @@ contains
   end subroutine f90_destroy
 
   ! gear: 12 arrays (x, v, a, b3, b4, b5, th, w, al, r3, r4, r5), each (N, 3) column-major, in `gear`.
-  ! coef: dt, half_dt2, two_over_dt2, cx, cv, c3, c4, c5; contact: hertz_pp, hertz_pw, gamma_n, gamma_t, mu.
+  ! coef: dt, half_dt2, two_over_dt2, cx, cv, c3, c4, c5; contact: hertz_pp, hertz_pw, gamma_n, gamma_t, mu, may_touch margin.
   subroutine f90_init(h, n, nw, cap, wcap, cell, radius, mass, inertia, gear, wn, wv, grav, coef, contact) &
       bind(C, name="demmat_f90_init")
     type(c_ptr), value :: h
     integer(c_int), value :: n, nw, cap, wcap
     real(c_double), value :: cell
     real(c_double), intent(in) :: radius(n), mass(n), inertia(n), gear(n, 3, 12), wn(3, nw), wv(3, nw)
-    real(c_double), intent(in) :: grav(3), coef(8), contact(5)
+    real(c_double), intent(in) :: grav(3), coef(8), contact(6)
     type(processor), pointer :: p
     p => get(h)
     p%n = n; p%nw = nw; p%cap = cap; p%wcap = wcap; p%cell = cell
     p%dt = coef(1); p%half_dt2 = coef(2); p%two_over_dt2 = coef(3)
     p%cx = coef(4); p%cv = coef(5); p%c3 = coef(6); p%c4 = coef(7); p%c5 = coef(8)
     p%hertz_pp = contact(1); p%hertz_pw = contact(2); p%gamma_n = contact(3); p%gamma_t = contact(4); p%mu = contact(5)
+    p%margin = contact(6)
     p%g = grav
     p%x = gear(:, :, 1); p%v = gear(:, :, 2); p%a = gear(:, :, 3)
     p%b3 = gear(:, :, 4); p%b4 = gear(:, :, 5); p%b5 = gear(:, :, 6)

@@ -1,7 +1,7 @@
 // The linked-list contact store: the design the DEMMAT paper rejected ("the linked list method based
 // on pointers and target variables", because a list rebuilt every step allocates and frees a node for
 // every contact every step). The particles' state is the arrays variant's own (ColumnState, flat arrays
-// column by column); only the contact store differs, so a comparison with arrays isolates it.
+// column by column, demmat/column_state.hpp); only the contact store differs, so a comparison with arrays isolates it.
 //
 // Particle i owns a singly linked list of nodes {partner j > i, next}, kept sorted by partner id, and a
 // second list of its wall contacts, sorted by wall index. Each step the search finds the current
@@ -27,7 +27,7 @@
 #include <memory>
 #include <vector>
 
-#include "../arrays/column_state.hpp"
+#include "demmat/column_state.hpp"
 #include "demmat/features.hpp"
 #include "demmat/linked_cells.hpp"
 #include "demmat/registry.hpp"
@@ -150,7 +150,10 @@ private:
 // Rebuild: empty every list (release all nodes) at the start of each search, so the merge acquires a
 // fresh node for every candidate; otherwise the lists persist from step to step.
 template <class T, class M, class Nodes, bool Rebuild = false>
-class LinkedListVariant final : public Variant {
+class LinkedListVariant final : public ColumnStateVariant<T, M> {
+    using ColumnStateVariant<T, M>::state_, ColumnStateVariant<T, M>::pp_, ColumnStateVariant<T, M>::pw_,
+        ColumnStateVariant<T, M>::candidates_;
+
 public:
     LinkedListVariant() = default;
     LinkedListVariant(const LinkedListVariant&) = delete;
@@ -174,8 +177,6 @@ public:
         cells_.reserve(n);
         pp_ = pw_ = candidates_ = 0;
     }
-
-    void predict(std::int64_t step) override { state_.predict(step); }
 
     void search() override
     {
@@ -202,12 +203,6 @@ public:
                     if (state_.wall(i, std::size_t(node->partner))) ++pw_;
         state_.newton();
     }
-
-    void correct() override { state_.correct(); }
-    void snapshot(Snapshot& out) const override { state_.snapshot(out); }
-    void save(State& out) const override { state_.save(out); }
-    ContactCounts counts() const override { return {pp_, pw_, candidates_}; }
-    ModelFeatures model() const override { return ModelFeatures::of<M>(); }
 
     std::size_t memory_bytes() const override
     {
@@ -286,7 +281,6 @@ private:
         pp_live_ = pw_live_ = 0;
     }
 
-    ColumnState<T, M> state_;
     T cell_ = T(0);
     // Declared before the list heads, so it outlives them on destruction (the destructor empties the
     // lists first in any case).
@@ -296,7 +290,6 @@ private:
     std::size_t pp_live_ = 0, pw_live_ = 0;
     std::vector<Index> scratch_;  // one particle's candidates during the search
     LinkedCells cells_;
-    std::int64_t pp_ = 0, pw_ = 0, candidates_ = 0;
 };
 
 // The instantiation a run gets, picked in init() as in arrays (the same ColumnState, the same models), so

@@ -21,6 +21,11 @@ struct ContactParams {
     T gamma_t{};   // tangential viscous coefficient, 1/s
     T mu{};        // Coulomb friction coefficient
 
+    // The effective moduli E* themselves (physics.md §2, §8: contact time, maximum overlap), derived here
+    // only, from the stored (4/3)·E*.
+    T estar_pp() const { return T(0.75) * hertz_pp; }
+    T estar_pw() const { return T(0.75) * hertz_pw; }
+
     template <class U>
     ContactParams<U> as() const
     {
@@ -42,13 +47,15 @@ struct ContactForce {
 // d2 and sqrt (about 1e-16 relative), so any search that keeps the pairs this accepts hands the law a
 // superset of the contact set, and the law alone decides; the trajectory then cannot depend on the
 // search method.
+inline constexpr double kMayTouchMargin = 1.000000001;  // the relative margin, 1 + 1e-9 (also passed to the ports)
+
 template <class T>
 DEMMAT_HD inline bool may_touch(const Vec3<T>& xi, const Vec3<T>& xj, T ri, T rj)
 {
     const Vec3<T> dx = xj - xi;
     const T d2 = dot(dx, dx);
     const T s = ri + rj;
-    return d2 < s * s * T(1.000000001);
+    return d2 < s * s * T(kMayTouchMargin);
 }
 
 // The same test on W pairs at once (lanes.hpp), the same operations lane by lane: nonzero in the lanes
@@ -59,13 +66,13 @@ inline auto may_touch_lanes(const Vec3<V>& xi, const Vec3<V>& xj, V ri, V rj)
     const Vec3<V> dx = xj - xi;
     const V d2 = dot(dx, dx);
     const V s = ri + rj;
-    return d2 < s * s * LaneScalar<V>(1.000000001);
+    return d2 < s * s * LaneScalar<V>(kMayTouchMargin);
 }
 template <class T>
 DEMMAT_HD inline bool may_touch_wall(const Vec3<T>& xi, T ri, const Vec3<T>& point, const Vec3<T>& normal)
 {
     // The law tests ri - s > 0 with exactly this s; the margin only makes the list a superset.
-    return dot(xi - point, normal) < ri * T(1.000000001);
+    return dot(xi - point, normal) < ri * T(kMayTouchMargin);
 }
 
 // The contact's effective coefficients (physics.md §2): kn = (4/3)E*·sqrt(R*) multiplies h·sqrt(h),

@@ -1,6 +1,9 @@
 #pragma once
 // Which model features a run needs (model.hpp): derived from the scene and its initial state, never
 // chosen by hand, so a scene that needs a feature never runs a model without it.
+#include <functional>
+#include <memory>
+
 #include "demmat/model.hpp"
 #include "demmat/scene.hpp"
 #include "demmat/state.hpp"
@@ -20,12 +23,6 @@ ModelFeatures features_of(const Scene& scene, const State& state);
 // benchmarks run a more general model on purpose; nothing can narrow it).
 inline ModelFeatures model_for(const Setup& setup) { return features_of(*setup.scene, *setup.state) | setup.widen; }
 
-} // namespace demmat
-
-#include <functional>
-#include <memory>
-
-namespace demmat {
 
 // A registered variant whose init() picks the instantiation that runs: `pick(setup)` returns it (a
 // specialising variant calls with_model(model_for(setup), …) there), and every phase is forwarded to

@@ -79,7 +79,7 @@ public:
         const double coef[8] = {k.dt, k.half_dt2, k.two_over_dt2, k.cx, k.cv, k.c3, k.c4, k.c5};
         const ContactParams<double>& p = setup.contact;
         // The last entry is may_touch's margin, passed as a double so no port parses a decimal literal.
-        const double contact[6] = {p.hertz_pp, p.hertz_pw, p.gamma_n, p.gamma_t, p.mu, 1.000000001};
+        const double contact[6] = {p.hertz_pp, p.hertz_pw, p.gamma_n, p.gamma_t, p.mu, kMayTouchMargin};
         const double grav[3] = {scene.gravity.x, scene.gravity.y, scene.gravity.z};
         api_.init(h_, int(n_), int(nw), cap_, wcap_, setup.cell_size, s.radius.data(), setup.mass.data(),
                         setup.inertia.data(), gear.data(), wn.data(), wv.data(), grav, coef, contact);

@@ -17,9 +17,13 @@ namespace demmat {
 double hertz_max_overlap(double mstar, double rstar, double estar, double speed);
 double hertz_contact_time(double mstar, double rstar, double estar, double speed);
 
-// The largest impact speed a scene can explain (docs/stability.md): v_p = fastest initial grain + a free
-// fall across the domain's diagonal + the fastest wall; two grains can meet head-on at 2·v_p, a single
-// grain meets a wall at v_p + the fastest wall.
+// The fastest a grain can move by what the scene explains, v_p = fastest initial grain + a free fall
+// across the domain's diagonal + the fastest wall (the driver's speed check allows ten times it).
+double explained_speed(const Scene& scene, const State& state);
+double fastest_wall_speed(const State& state);
+
+// The largest impact speed a scene can explain (docs/stability.md): two grains can meet head-on at 2·v_p,
+// a single grain meets a wall at v_p + the fastest wall.
 double impact_speed_bound(const Scene& scene, const State& state);
 
 // The shortest Hertz contact time of the scene at `speed`: the pair of two smallest grains, and (with
@@ -37,6 +41,11 @@ double stable_fraction_of_contact_time(Integrator scheme);
 // Above this Δt/t_c (fewer than 20 steps per contact) `demmat run` warns: the restitution is then off
 // by more than about 1 % for the paper's Gear scheme (docs/stability.md).
 inline constexpr double kWarnFractionOfContactTime = 0.05;
+
+// Refuses a time step above the Rayleigh time of the smallest particle (a scene that cannot be stable)
+// and returns a warning (empty if none) when Δt exceeds 0.2 of it, the usual rule of thumb; likewise for
+// the Hertz contact time at the scene's largest impact speed (check_contact_time_step, below).
+std::string check_time_step(const Scene& scene, const State& state);
 
 // Refuses (throws Error, one line) a Δt above the scene's integrator's stability limit in units of the
 // shortest contact time at the largest impact speed; returns a warning (empty if none) above

@@ -62,11 +62,9 @@ std::vector<Wall> continue_walls(const Scene& scene, const State& saved);
 // Validates the particles (radii, overlaps, walls) and throws Error with one line on bad input.
 State initial_state(const Scene& scene);
 
-} // namespace demmat
+// The t = 0 accelerations of a state that starts afresh (design.md, decision 4): a = F(x, v)/m + g and
+// α = T/I, the forces and torques summed in the canonical order by the reference code (reference.hpp).
+// Sets trans.a and rot.a; the other Gear values are left as they are.
+void initial_accelerations(const Scene& scene, State& state);
 
-namespace demmat {
-// Refuses a time step above the Rayleigh time of the smallest particle (a scene that cannot be stable)
-// and returns a warning (empty if none) when Δt exceeds 0.2 of it, the usual rule of thumb; likewise for
-// the Hertz contact time at the scene's largest impact speed (check_contact_time_step, stability.hpp).
-std::string check_time_step(const Scene& scene, const State& state);
 } // namespace demmat

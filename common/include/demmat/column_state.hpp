@@ -3,7 +3,8 @@
 // (N, 3) stored column by column (x(i, c) at x[c·N + i], as Fortran stores them), the walls, and the
 // four phases' work on them that does not depend on the contact store: loading from Setup, the Gear
 // predictor and corrector, accumulating one contact's force and torque, and Newton's law. The arrays
-// variant and the linked-list variants both hold one, so a comparison of them isolates the contact store.
+// variant and the linked-list variants are both a ColumnStateVariant (below), so a comparison of them
+// isolates the contact store.
 #include <algorithm>
 #include <cstddef>
 #include <cstdint>
@@ -209,6 +210,23 @@ private:
     std::vector<T> f_, t_, acc_, alc_;                                      // (N, 3) each
     std::vector<T> r_, m_, I_;                                              // (N)
     std::vector<T> wp_, wn_, wv_;                                           // (3, walls)
+};
+
+// A variant over a ColumnState: the phases and queries that do not touch the contact store. A subclass
+// adds the store: init (calling state_.load), search, forces (setting pp_, pw_, candidates_), memory_bytes.
+template <class T, class M, class S = Gear5Scheme>
+class ColumnStateVariant : public Variant {
+public:
+    void predict(std::int64_t step) override { state_.predict(step); }
+    void correct() override { state_.correct(); }
+    void snapshot(Snapshot& out) const override { state_.snapshot(out); }
+    void save(State& out) const override { state_.save(out); }
+    ContactCounts counts() const override { return {pp_, pw_, candidates_}; }
+    ModelFeatures model() const override { return ModelFeatures::of<M>(); }
+
+protected:
+    ColumnState<T, M, S> state_;
+    std::int64_t pp_ = 0, pw_ = 0, candidates_ = 0;  // the last forces phase's contact counts
 };
 
 } // namespace demmat
