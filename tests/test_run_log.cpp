@@ -133,7 +133,7 @@ TEST(RunLog, PairContactsCountAndTheirReactionsBalanceTheWeightOnTheFloor)
     // The pair holds one weight with R* = r/2 and E*_pp; the wall holds two with R* = r and E*_pw.
     const double epp = c.setup.contact.hertz_pp * 0.75;
     const double h_pair = std::pow(3.0 * m * 10.0 / (4.0 * epp * std::sqrt(r / 2)), 2.0 / 3.0);
-    const double h_wall = std::pow(3.0 * 2.0 * m * 10.0 / (4.0 * c.setup.contact.hertz_pw * 0.75 * std::sqrt(r)), 2.0 / 3.0);
+    const double h_wall = std::pow(3.0 * 2.0 * m * 10.0 / (4.0 * c.setup.contact.estar_pw() * std::sqrt(r)), 2.0 / 3.0);
     EXPECT_NEAR(row.largest_overlap_ratio, std::max(h_pair, h_wall) / r, 1e-5 * std::max(h_pair, h_wall) / r);
 }
 

@@ -92,7 +92,7 @@ std::string check_contact_time_step(const Scene& scene, const State& state)
                                 "impact speed {:.3g} m/s), above the {} stability limit {} of it: the run would be unstable; "
                                 "use dt <= {:.3g} s (or --allow-unstable)",
                                 scene.name, scene.dt, ratio, ct.tc, what, v, name(scene.integrator.scheme), limit,
-                                kWarnFractionOfContactTime * ct.tc));
+                                std::min(kWarnFractionOfContactTime, limit) * ct.tc));  // within this integrator's limit
     if (ratio > kWarnFractionOfContactTime)
         return fmt::format("time step {:g} s is {:.3g} of the Hertz contact time {:.3g} s ({} at the scene's largest impact "
                            "speed {:.3g} m/s); above {} of it a contact takes fewer than {:.0f} steps and its restitution is inaccurate",
