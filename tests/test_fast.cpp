@@ -2,8 +2,13 @@
 // the dense settling bed (2000 particles, 5000 steps) and on the compression stage (where the list is
 // rebuilt dozens of times, or every step with no skin), at 1, 2 and 3 threads; and fast_unordered,
 // which drops the canonical order, within a tolerance that only a change of summation order explains.
+#include <array>
 #include <cmath>
 #include <iostream>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include <fmt/format.h>
 
@@ -88,6 +93,26 @@ double relative_gap(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b)
             scale = std::max(scale, std::abs(component(a[i], c)));
         }
     return gap / scale;
+}
+
+// Steps `variant` (initialised) `steps` times, each phase on the team `teams[phase][step % size]` (0:
+// predict, 1: search, 2: forces), as OpenMP's dynamic teams may choose; `after` after each step.
+template <class After>
+void step_with_teams(Variant& variant, std::int64_t first_step, std::int64_t steps, const std::array<std::vector<int>, 3>& teams,
+                     After&& after)
+{
+    auto team = [&](int phase, std::int64_t k) { return teams[std::size_t(phase)][std::size_t(k) % teams[std::size_t(phase)].size()]; };
+    for (std::int64_t k = 1; k <= steps; ++k) {
+        set_threads(team(0, k));
+        variant.predict(first_step + k);
+        set_threads(team(1, k));
+        variant.search();
+        set_threads(team(2, k));
+        variant.forces();
+        variant.correct();
+        after(k);
+    }
+    set_threads(0);
 }
 
 } // namespace
@@ -205,4 +230,79 @@ TEST(Fast, UnorderedIsDeterministicForAFixedThreadCount)
         ASSERT_FALSE(d) << "step " << k + 1 << ": " << d->describe();
     }
     set_threads(0);
+}
+
+TEST(Fast, PhasesOnTeamsOfDifferentSizesGiveTheSameTrajectory)
+{
+    // The wall candidates are listed per thread by predict() (or a rebuild), the force pass reads them:
+    // with OpenMP's dynamic teams (omp_set_dynamic, OMP_DYNAMIC=true) the two may run on teams of
+    // different sizes, which must change no bit. Every phase here on its own cycle of 1, 2 and 3 threads,
+    // through the compression stage (rebuilds, wall contacts), against arrays at every step.
+    Case c = bed_case(0.5);
+    FastOptions o;
+    o.min_parallel = 0;
+    o.prefetch_from = 0;
+    auto fast = make_fast_variant(o);
+    fast->init(c.setup);
+    VariantRun ref("arrays", c.setup);
+    Snapshot a, b;
+    std::string difference;
+    step_with_teams(*fast, c.state.step, 400, {{{3, 1, 2}, {1, 3}, {2, 3, 1, 1}}}, [&](std::int64_t k) {
+        ref.driver->step();
+        ref.variant->snapshot(a);
+        fast->snapshot(b);
+        if (difference.empty())
+            if (const auto d = first_difference(a, b)) difference = fmt::format("step {}: {}", k, d->describe());
+    });
+    EXPECT_EQ(difference, "");
+    EXPECT_GT(ref.variant->counts().particle_wall, 0);
+    EXPECT_GT(fast->rebuilds(), 5);
+}
+
+TEST(Fast, UnorderedForcesDoNotDependOnTheTeamsOfTheOtherPhases)
+{
+    // fast_unordered's bits depend on the force pass's team, not on those of predict() and the rebuild.
+    Case c = bed_case(0.5);
+    auto fixed = make_fast_variant(threaded_unordered()), varied = make_fast_variant(threaded_unordered());
+    fixed->init(c.setup);
+    varied->init(c.setup);
+    step_with_teams(*fixed, c.state.step, 300, {{{2}, {2}, {2}}}, [](std::int64_t) {});
+    step_with_teams(*varied, c.state.step, 300, {{{3, 1}, {1, 3, 2}, {2}}}, [](std::int64_t) {});
+    Snapshot a, b;
+    fixed->snapshot(a);
+    varied->snapshot(b);
+    const auto d = first_difference(a, b);
+    EXPECT_FALSE(d) << d->describe();
+}
+
+#ifdef _OPENMP
+TEST(Fast, DynamicTeamsGiveTheSameTrajectory)
+{
+    // OpenMP's own dynamic teams (their sizes follow the machine's load): bit-identical to arrays.
+    Case c = bed_case(0.5);
+    omp_set_dynamic(1);
+    const auto r = lockstep(c.setup, 300, {{FastOptions{}, 3}, {FastOptions{}, 2}});
+    omp_set_dynamic(0);
+    EXPECT_EQ(r.difference, "");
+}
+#endif
+
+TEST(Fast, ReportsTheThreadsItRunsOn)
+{
+    // Below min_parallel one thread whatever is asked; above, the force pass's team.
+    Case c = bed_case(0.5);
+    ASSERT_LT(c.state.size(), FastOptions{}.min_parallel);
+    set_threads(2);
+    VariantRun small(make_fast_variant(FastOptions{}), c.setup);
+    FastOptions threaded;
+    threaded.min_parallel = 0;
+    VariantRun big(make_fast_variant(threaded), c.setup);
+    small.driver->step();
+    big.driver->step();
+    EXPECT_EQ(small.variant->threads_used(), 1);
+#ifdef _OPENMP
+    EXPECT_EQ(big.variant->threads_used(), 2);
+#endif
+    set_threads(0);
+    EXPECT_EQ(VariantRun("arrays", c.setup).variant->threads_used(), 1);
 }

@@ -97,6 +97,14 @@ struct SlotSource {
 template <class T>
 using Quad = Pack<T, 4>;
 
+// Quads go by reference, never by value: built for the baseline (DEMMAT_FAST_NATIVE off), a 32-byte
+// vector passed or returned by value changes the calling convention (GCC's -Wpsabi notes).
+template <class T>
+[[gnu::always_inline]] inline void load_quad(Quad<T>& q, const T* p)
+{
+    std::memcpy(&q, p, sizeof(q));
+}
+
 // A particle's kinematics as the pair kernel reads them, one record per particle (written by predict()'s
 // pass, and by a rebuild): position and radius, velocity, angular velocity, a quad each, so that a
 // lane's particle is three loads of one record, not ten from ten arrays.
@@ -268,10 +276,12 @@ public:
         // the rebuild, whose cell search reports it. (Walls need no list: see mark_walls.)
         const T half = T(0.9) * skin_ * T(0.5);
         int over = !(half > T(0));
+        std::size_t listing_team = 1;
 #pragma omp parallel reduction(| : over) if (par_)
         {
             const auto [lo, hi] = thread_range(n_);
             const std::size_t t = std::size_t(thread_index());
+            if (t == 0) listing_team = std::size_t(thread_count());
             wall_cand_[t].clear();
             for (std::size_t b0 = lo; b0 < hi; b0 += kPassBlock) {
                 const std::size_t b1 = std::min(hi, b0 + kPassBlock);
@@ -283,6 +293,7 @@ public:
             }
             wall_res_[t].resize(wall_cand_[t].size());
         }
+        wall_lists_listed(listing_team);
         rebuild_due_ = over != 0;
     }
 
@@ -333,6 +344,8 @@ public:
 
     ContactCounts counts() const override { return {pp_, pw_, std::int64_t(partner_.size())}; }
     std::int64_t rebuilds() const override { return rebuilds_; }
+    // The team of the last force pass; before one, the team it will get (one below min_parallel).
+    int threads_used() const override { return team_ > 0 ? int(team_) : par_ ? thread_limit() : 1; }
 
     std::size_t memory_bytes() const override
     {
@@ -353,7 +366,7 @@ public:
         for (const auto& l : wall_res_) b += l.capacity() * sizeof(Load<T>);
         for (const auto& l : wall_cand_) b += l.capacity() * sizeof(WallCandidate);
         for (const auto& v : scan_) b += v.capacity() * sizeof(Index);
-        b += (piece_chunk_.capacity() + range_end_.capacity()) * sizeof(std::size_t);
+        b += (piece_chunk_.capacity() + wall_range_end_.capacity()) * sizeof(std::size_t);
         b += nclaims_ * sizeof(Claim);
         return b;
     }
@@ -578,13 +591,13 @@ private:
             for (int l = 0; l < kLanes; ++l) rows[l] = row(l);
             rows_to_lanes<Lanes>(rows, out);
         };
-        lanes([&](int l) { return kin[s[l]].xr; }, xi);
-        lanes([&](int l) { return kin[q[l]].xr; }, xj);
-        lanes([&](int l) { return kin[s[l]].v; }, vi);
-        lanes([&](int l) { return kin[q[l]].v; }, vj);
+        lanes([&](int l) -> const Quad<T>& { return kin[s[l]].xr; }, xi);
+        lanes([&](int l) -> const Quad<T>& { return kin[q[l]].xr; }, xj);
+        lanes([&](int l) -> const Quad<T>& { return kin[s[l]].v; }, vi);
+        lanes([&](int l) -> const Quad<T>& { return kin[q[l]].v; }, vj);
         if constexpr (M::rotation) {
-            lanes([&](int l) { return kin[s[l]].w; }, wi);
-            lanes([&](int l) { return kin[q[l]].w; }, wj);
+            lanes([&](int l) -> const Quad<T>& { return kin[s[l]].w; }, wi);
+            lanes([&](int l) -> const Quad<T>& { return kin[q[l]].w; }, wj);
         }
         ContactForce<Lanes> c;
         // The pair's coefficients from R and m in the lanes (computing them costs less than reading
@@ -645,13 +658,11 @@ private:
         const T* __restrict r = r_.data();
         const T* __restrict m = m_.data();
         Kin<T>* __restrict kin = kin_.data();
-        auto quad = [](const T* p) {
-            Quad<T> q;
-            std::memcpy(&q, p, sizeof(q));
-            return q;
-        };
         auto records = [&](std::size_t s, const T* c, const Quad<T>& fourth, Quad<T> Kin<T>::*field) {
-            Quad<T> a = quad(c + s), b = quad(c + n + s), d = quad(c + 2 * n + s), e = fourth;
+            Quad<T> a, b, d, e = fourth;
+            load_quad(a, c + s);
+            load_quad(b, c + n + s);
+            load_quad(d, c + 2 * n + s);
             transpose4<T>(a, b, d, e);
             kin[s].*field = a;
             kin[s + 1].*field = b;
@@ -660,8 +671,11 @@ private:
         };
         std::size_t s = lo;
         for (; s + 4 <= hi; s += 4) {
-            records(s, x, quad(r + s), &Kin<T>::xr);
-            records(s, v, quad(m + s), &Kin<T>::v);
+            Quad<T> radii, masses;
+            load_quad(radii, r + s);
+            load_quad(masses, m + s);
+            records(s, x, radii, &Kin<T>::xr);
+            records(s, v, masses, &Kin<T>::v);
             records(s, w, Quad<T>{}, &Kin<T>::w);
         }
         for (; s < hi; ++s) {
@@ -683,18 +697,18 @@ private:
         const std::size_t chunks = (n + kChunk - 1) / kChunk, span = span_chunks_;
         const std::size_t limit = std::size_t(thread_limit());
         per_thread_claims();
+        std::size_t team = 1;
         if (rings_.size() < limit) rings_.resize(limit);
 #pragma omp parallel reduction(+ : pp, pw) if (par_)
         {
             const std::size_t nt = std::size_t(thread_count()), t = std::size_t(thread_index());
+            if (t == 0) team = nt;
             // Two threads to a piece, one from each end; an odd thread count leaves the last piece one.
             const std::size_t pieces = (nt + 1) / 2, p = t / 2;
             const bool down = t % 2 == 1;
 #pragma omp single
             {
                 cut_pieces(pieces, chunks);
-                range_end_.resize(nt);
-                for (std::size_t u = 0; u < nt; ++u) range_end_[u] = n * (u + 1) / nt;  // thread_range's ends
                 for (std::size_t q = 0; q < pieces; ++q)
                     claims_[q].v.store(std::uint64_t(piece_chunk_[q + 1]) << 32 | std::uint64_t(piece_chunk_[q]), std::memory_order_relaxed);
                 if (pieces > 1) slot_.resize(partner_.size() + 1);  // + 1: a sum reads a quad from the last slot's t_j
@@ -774,6 +788,7 @@ private:
         }
         pp_ = pp;
         pw_ = pw;
+        team_ = team;
     }
 
     // A piece's claims: the next chunk up (low 32 bits) and one past the next chunk down (high 32 bits);
@@ -843,21 +858,27 @@ private:
         const T* lo = reinterpret_cast<const T*>(from.lo);
         const T* hi = reinterpret_cast<const T*>(from.hi);
         const std::size_t mask = from.mask, split = from.split;
-        auto quad_at = [=](std::size_t k, std::size_t offset) {
-            Quad<T> q;
-            std::memcpy(&q, (k < split ? lo : hi) + 9 * (k & mask) + offset, sizeof(q));
-            return q;
-        };
+        auto at = [=](std::size_t k, std::size_t offset) { return (k < split ? lo : hi) + 9 * (k & mask) + offset; };
         const Index* lslot = lslot_.data();
         Quad<T> f{}, tq{};
         for (Index e = lstart_[s]; e < lstart_[s + 1]; ++e) {
             const std::size_t k = std::size_t(lslot[e]);
-            f -= quad_at(k, 0);
-            if constexpr (M::rotation) tq += quad_at(k, 6);
+            Quad<T> q;
+            load_quad(q, at(k, 0));
+            f -= q;
+            if constexpr (M::rotation) {
+                load_quad(q, at(k, 6));
+                tq += q;
+            }
         }
         for (Index k = pstart_[s]; k < pstart_[s + 1]; ++k) {
-            f += quad_at(std::size_t(k), 0);
-            if constexpr (M::rotation) tq += quad_at(std::size_t(k), 3);
+            Quad<T> q;
+            load_quad(q, at(std::size_t(k), 0));
+            f += q;
+            if constexpr (M::rotation) {
+                load_quad(q, at(std::size_t(k), 3));
+                tq += q;
+            }
         }
         finish_sum(s, f, tq);
     }
@@ -877,39 +898,60 @@ private:
         const char* base = reinterpret_cast<const char*>(ring);
         const char* ti = base + 3 * sizeof(T);  // where the torques start, for a slot at offset 0
         const char* tj = base + 6 * sizeof(T);
-        auto quad_at = [](const char* at) {
+        auto add = [](Quad<T>& sum, const char* at) {
             Quad<T> q;
             std::memcpy(&q, at, sizeof(q));
-            return q;
+            sum += q;
+        };
+        auto subtract = [](Quad<T>& sum, const char* at) {
+            Quad<T> q;
+            std::memcpy(&q, at, sizeof(q));
+            sum -= q;
         };
         const std::uint32_t* row = group_table_.data() + g.table;
         Quad<T> f[kGroup]{}, tq[kGroup]{};
         for (std::int32_t e = 0; e < g.as_j; ++e, row += kGroup)
             for (int l = 0; l < kGroup; ++l) {
-                f[l] -= quad_at(base + row[l]);
-                if constexpr (M::rotation) tq[l] += quad_at(tj + row[l]);
+                subtract(f[l], base + row[l]);
+                if constexpr (M::rotation) add(tq[l], tj + row[l]);
             }
         for (std::int32_t e = 0; e < g.as_i; ++e, row += kGroup)
             for (int l = 0; l < kGroup; ++l) {
-                f[l] += quad_at(base + row[l]);
-                if constexpr (M::rotation) tq[l] += quad_at(ti + row[l]);
+                add(f[l], base + row[l]);
+                if constexpr (M::rotation) add(tq[l], ti + row[l]);
             }
         for (int l = 0; l < g.count; ++l) finish_sum(std::size_t(g.grain[l]), f[l], tq[l]);
     }
 
-    // Particle s's walls added to its sum (f, tq), in wall order, and the sum stored in f_ and t_.
-    void finish_sum(std::size_t s, Quad<T> f, Quad<T> tq)
+    // Particle s's walls added to its sum (f, tq), in wall order (zeros for a pair out of contact add
+    // nothing).
+    void add_walls(std::size_t s, Quad<T>& f, Quad<T>& tq) const
     {
-        if (near_wall_[s]) {
-            std::size_t u = 0;  // the thread whose range holds s (a division here cost 2 % of the step at 16000 grains)
-            while (s >= range_end_[u]) ++u;
-            const std::vector<WallCandidate>& cand = wall_cand_[u];
-            const Load<T>* res = wall_res_[u].data();
-            for (std::size_t e = std::size_t(wall_first_[s]); e < cand.size() && std::size_t(cand[e].s) == s; ++e) {
-                f += res[e].f;
-                if constexpr (M::rotation) tq += res[e].t;
-            }
+        if (!near_wall_[s]) return;
+        std::size_t u = 0;  // the list that holds s: its range among the listing team's (a loop, not a division: cheaper)
+        while (s >= wall_range_end_[u]) ++u;
+        const std::vector<WallCandidate>& cand = wall_cand_[u];
+        const Load<T>* res = wall_res_[u].data();
+        for (std::size_t e = std::size_t(wall_first_[s]); e < cand.size() && std::size_t(cand[e].s) == s; ++e) {
+            f += res[e].f;
+            if constexpr (M::rotation) tq += res[e].t;
         }
+    }
+
+    // The wall candidates were listed by a team of `team` threads, each its range of the particles
+    // (thread_range), into wall_cand_[0 … team): the force pass, whatever its own team (OpenMP's dynamic
+    // teams may give it another), reads those lists and finds a particle's by these ranges.
+    void wall_lists_listed(std::size_t team)
+    {
+        wall_lists_ = team;
+        wall_range_end_.resize(team);
+        for (std::size_t u = 0; u < team; ++u) wall_range_end_[u] = n_ * (u + 1) / team;  // thread_range's ends
+    }
+
+    // Particle s's walls added to its sum (f, tq), and the sum stored in f_ and t_.
+    void finish_sum(std::size_t s, Quad<T>& f, Quad<T>& tq)
+    {
+        add_walls(s, f, tq);
         const std::size_t n = n_;
         for (int c = 0; c < 3; ++c) {
             f_[std::size_t(c) * n + s] = f[c];
@@ -986,7 +1028,7 @@ private:
     // contacts found.
     std::int64_t wall_contacts()
     {
-        const std::size_t nt = std::size_t(thread_count());
+        const std::size_t nt = wall_lists_;
         auto packs_of = [this](std::size_t u) { return (wall_cand_[u].size() + kLanes - 1) / kLanes; };
         std::size_t packs = 0;
         for (std::size_t u = 0; u < nt; ++u) packs += packs_of(u);
@@ -1016,12 +1058,12 @@ private:
             for (int l = 0; l < kLanes; ++l) rows[l] = row(l);
             rows_to_lanes<Lanes>(rows, to);
         };
-        lanes([&](int l) { return kin_[s[l]].xr; }, xr);
-        lanes([&](int l) { return kin_[s[l]].v; }, v);
-        if constexpr (M::rotation) lanes([&](int l) { return kin_[s[l]].w; }, om);
-        lanes([&](int l) { return wall_rec_[w[l]].p; }, p);
-        lanes([&](int l) { return wall_rec_[w[l]].n; }, nrm);
-        if constexpr (M::moving_walls) lanes([&](int l) { return wall_rec_[w[l]].v; }, vw);
+        lanes([&](int l) -> const Quad<T>& { return kin_[s[l]].xr; }, xr);
+        lanes([&](int l) -> const Quad<T>& { return kin_[s[l]].v; }, v);
+        if constexpr (M::rotation) lanes([&](int l) -> const Quad<T>& { return kin_[s[l]].w; }, om);
+        lanes([&](int l) -> const Quad<T>& { return wall_rec_[w[l]].p; }, p);
+        lanes([&](int l) -> const Quad<T>& { return wall_rec_[w[l]].n; }, nrm);
+        if constexpr (M::moving_walls) lanes([&](int l) -> const Quad<T>& { return wall_rec_[w[l]].v; }, vw);
         ContactForce<Lanes> c;
         auto vec = [](const Lanes* a) { return Vec3<Lanes>{a[0], a[1], a[2]}; };
         static_assert(M::polydisperse, "the wall kernel computes each particle's coefficients");
@@ -1041,26 +1083,6 @@ private:
         return found;
     }
 
-    // A thread's wall results, read by its sums in particle order.
-    struct WallCursor {
-        const WallCandidate* cand;
-        const Load<T>* res;
-        std::size_t count, next = 0;
-        // Adds particle s's wall contacts (wall order; zeros for a pair out of contact add nothing) and
-        // moves past them.
-        void add(std::size_t s, Vec3<T>& F, Vec3<T>& Tq)
-        {
-            for (; next < count && std::size_t(cand[next].s) == s; ++next) {
-                F += Vec3<T>{res[next].f[0], res[next].f[1], res[next].f[2]};
-                if constexpr (M::rotation) Tq += Vec3<T>{res[next].t[0], res[next].t[1], res[next].t[2]};
-            }
-        }
-    };
-
-    // Thread t's wall candidates (listed by predict() or a rebuild) and their results, which
-    // wall_contacts computes and the unordered sums add through this cursor.
-    WallCursor wall_cursor(std::size_t t) { return {wall_cand_[t].data(), wall_res_[t].data(), wall_cand_[t].size()}; }
-
     // Unordered: each pair's force added to both particles as the pack computes it, into loads of the
     // thread's own (zeroed over the span of particles its slots reach, set at the rebuild), then each
     // particle's loads summed over the threads whose span holds it, in thread order, and its walls.
@@ -1070,9 +1092,11 @@ private:
         const std::size_t limit = std::size_t(thread_limit());
         if (loads_.size() < limit) loads_.resize(limit);
         std::int64_t pp = 0, pw = 0;
+        std::size_t team = 1;
 #pragma omp parallel reduction(+ : pp, pw) if (par_)
         {
             const std::size_t nt = std::size_t(thread_count()), t = std::size_t(thread_index());
+            if (t == 0) team = nt;
             const auto [lo, hi] = thread_range(n);
             // A thread count other than the rebuild's (no rebuild since it changed): every thread zeroes all.
             const bool spans_known = span_threads_ == nt;
@@ -1080,7 +1104,6 @@ private:
             if (mine.size() != n) mine.resize(n);
             const auto [z0, z1] = spans_known ? spans_[t] : std::pair<std::size_t, std::size_t>{0, n};
             std::fill(mine.begin() + std::ptrdiff_t(z0), mine.begin() + std::ptrdiff_t(z1), Load<T>{});
-            WallCursor walls = wall_cursor(t);  // listed by predict() or a rebuild, like the kernel's records
             pw += wall_contacts();
             pp += slots_of<false>(std::size_t(pstart_[lo]), std::size_t(pstart_[hi]), mine.data());
 #pragma omp barrier
@@ -1092,14 +1115,14 @@ private:
                     f += loads_[u][s].f;
                     tq += loads_[u][s].t;
                 }
-                Vec3<T> F{f[0], f[1], f[2]}, Tq{tq[0], tq[1], tq[2]};
-                walls.add(s, F, Tq);
-                put(f_, s, F);
-                put(t_, s, Tq);
+                add_walls(s, f, tq);
+                put(f_, s, Vec3<T>{f[0], f[1], f[2]});
+                put(t_, s, Vec3<T>{tq[0], tq[1], tq[2]});
             }
         }
         pp_ = pp;
         pw_ = pw;
+        team_ = team;
     }
 
     // ---- the neighbour list ---------------------------------------------------------------------
@@ -1179,16 +1202,19 @@ private:
         // The new storage order's kernel records, wall bits and wall candidates (predict() made them for
         // the old one).
         per_thread_walls();
+        std::size_t listing_team = 1;
 #pragma omp parallel if (par_)
         {
             const auto [lo, hi] = thread_range(n);
             const std::size_t t = std::size_t(thread_index());
+            if (t == 0) listing_team = std::size_t(thread_count());
             refresh_kin(lo, hi);
             mark_walls(lo, hi);
             wall_cand_[t].clear();
             list_walls(lo, hi, t);
             wall_res_[t].resize(wall_cand_[t].size());
         }
+        wall_lists_listed(listing_team);
     }
 
     struct Key {
@@ -1430,7 +1456,7 @@ private:
     // by their last chunk (by_last_, from last_start_[chunk]) and by their first; where each piece
     // starts, in chunks.
     std::vector<Index> first_chunk_, last_chunk_, last_start_, by_last_, first_start_, by_first_;
-    std::vector<std::size_t> piece_chunk_, range_end_;  // range_end_: where each thread's range ends (thread_range)
+    std::vector<std::size_t> piece_chunk_;
     // The sums' groups of each chunk's two schedules (by last chunk, by first), from group_*_start_[chunk],
     // and their tables of ring offsets.
     std::vector<SumGroup> groups_last_, groups_first_;
@@ -1442,6 +1468,8 @@ private:
     std::size_t span_chunks_ = 0, ring_slots_ = 1;
     std::vector<std::vector<Slot<T>>> rings_;
     std::vector<std::vector<WallCandidate>> wall_cand_;  // per thread: the particle–wall pairs that may touch
+    std::size_t wall_lists_ = 0;                         // the team that listed them (wall_lists_listed)
+    std::vector<std::size_t> wall_range_end_;            // where each of its ranges ends
     std::vector<std::vector<Load<T>>> wall_res_;         // per thread: their force and torque (zeros: no contact)
     std::vector<Key> key_, keytmp_;
     std::vector<std::int64_t> cell3_;  // (3N) cell coordinates at the last rebuild
@@ -1455,6 +1483,7 @@ private:
     std::unique_ptr<Claim[]> claims_;  // per piece of the canonical sweep
     std::size_t nclaims_ = 0;
     std::int64_t pp_ = 0, pw_ = 0;
+    std::size_t team_ = 0;  // the threads of the last force pass (0: none yet)
 };
 
 } // namespace
