@@ -1,9 +1,15 @@
 // The fast variant against arrays at given thread counts and list skins: bit-identical at every step on
 // the dense settling bed (2000 particles, 5000 steps) and on the compression stage (where the list is
 // rebuilt dozens of times, or every step with no skin), at 1, 2 and 3 threads; and fast_unordered,
-// which drops the canonical order, within a tolerance that only a change of summation order explains.
+// which drops the canonical order, within a bound that only a change of summation order explains
+// (measured: the spread of fast_unordered itself over thread counts).
+#include <array>
 #include <cmath>
 #include <iostream>
+
+#ifdef _OPENMP
+#include <omp.h>
+#endif
 
 #include <fmt/format.h>
 
@@ -88,6 +94,26 @@ double relative_gap(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b)
             scale = std::max(scale, std::abs(component(a[i], c)));
         }
     return gap / scale;
+}
+
+// Steps `variant` (initialised) `steps` times, each phase on the team `teams[phase][step % size]` (0:
+// predict, 1: search, 2: forces), as OpenMP's dynamic teams may choose; `after` after each step.
+template <class After>
+void step_with_teams(Variant& variant, std::int64_t first_step, std::int64_t steps, const std::array<std::vector<int>, 3>& teams,
+                     After&& after)
+{
+    auto team = [&](int phase, std::int64_t k) { return teams[std::size_t(phase)][std::size_t(k) % teams[std::size_t(phase)].size()]; };
+    for (std::int64_t k = 1; k <= steps; ++k) {
+        set_threads(team(0, k));
+        variant.predict(first_step + k);
+        set_threads(team(1, k));
+        variant.search();
+        set_threads(team(2, k));
+        variant.forces();
+        variant.correct();
+        after(k);
+    }
+    set_threads(0);
 }
 
 } // namespace
@@ -177,18 +203,47 @@ TEST(Fast, UnorderedDiffersFromArraysOnlyByTheSummationOrder)
     ASSERT_TRUE(d) << "plain accumulation happened to give the canonical bits everywhere";
     std::cout << "fast_unordered against arrays, first difference: " << d->describe() << "\n";
 
-    // Over 1000 steps the chaotic bed amplifies those last bits, but the bed stays the same bed: every
-    // particle within 1 % of the smallest radius of where arrays puts it.
-    ref.driver->run(999);
-    unordered.driver->run(999);
-    const Snapshot a2 = ref.snapshot(), b2 = unordered.snapshot();
-    double worst = 0.0;
-    for (std::size_t i = 0; i < a2.position.size(); ++i) {
-        const Vec3d g = a2.position[i] - b2.position[i];
-        worst = std::max(worst, std::sqrt(dot(g, g)));
+    // Over the next steps the bed amplifies those last bits. How far a difference of summation order
+    // alone carries the bed over this horizon is measured, not assumed: fast_unordered on 1 and 3
+    // threads sums in other orders again (the loads of other threads), so the largest gap among the
+    // three runs at any step is what order alone gives here. The gap to arrays is a difference of the
+    // same kind and must stay within a margin of that (10x: such gaps scatter within a few times each
+    // other while they grow alike); a contact dropped or computed twice is no rounding, it changes a
+    // force by the contact's own size and leaves that bound within a few steps. (A one-ulp nudge of
+    // the start is no yardstick: larger than these differences, it moves contacts' first steps, whose
+    // damping force jumps, and grows orders of magnitude faster.)
+    const std::int64_t steps = 999;
+    std::vector<std::unique_ptr<VariantRun>> others;
+    for (int threads : {1, 3}) {
+        set_threads(threads);
+        others.push_back(std::make_unique<VariantRun>(make_fast_variant(threaded_unordered()), c.setup));
+        others.back()->driver->step();
     }
-    std::cout << "after 1000 steps the largest position gap is " << worst << " m\n";
-    EXPECT_LT(worst, 0.01 * 0.003);
+    auto largest_gap = [](const Snapshot& x, const Snapshot& y) {
+        double worst = 0.0;
+        for (std::size_t i = 0; i < x.position.size(); ++i) {
+            const Vec3d g = x.position[i] - y.position[i];
+            worst = std::max(worst, std::sqrt(dot(g, g)));
+        }
+        return worst;
+    };
+    double order = 0.0, worst = 0.0;
+    for (std::int64_t k = 0; k < steps; ++k) {
+        ref.driver->step();
+        set_threads(2);
+        unordered.driver->step();
+        set_threads(1);
+        others[0]->driver->step();
+        set_threads(3);
+        others[1]->driver->step();
+        const Snapshot u = unordered.snapshot(), u1 = others[0]->snapshot(), u3 = others[1]->snapshot();
+        order = std::max({order, largest_gap(u, u1), largest_gap(u, u3), largest_gap(u1, u3)});
+        worst = std::max(worst, largest_gap(ref.snapshot(), u));
+    }
+    std::cout << "over " << steps + 1 << " steps: order alone (fast_unordered on 1, 2, 3 threads) " << order
+              << " m; fast_unordered against arrays " << worst << " m\n";
+    EXPECT_GT(order, 0.0) << "the three orders gave the same bits: no yardstick";
+    EXPECT_LT(worst, 10.0 * order);
     set_threads(0);
 }
 
@@ -205,4 +260,79 @@ TEST(Fast, UnorderedIsDeterministicForAFixedThreadCount)
         ASSERT_FALSE(d) << "step " << k + 1 << ": " << d->describe();
     }
     set_threads(0);
+}
+
+TEST(Fast, PhasesOnTeamsOfDifferentSizesGiveTheSameTrajectory)
+{
+    // The wall candidates are listed per thread by predict() (or a rebuild), the force pass reads them:
+    // with OpenMP's dynamic teams (omp_set_dynamic, OMP_DYNAMIC=true) the two may run on teams of
+    // different sizes, which must change no bit. Every phase here on its own cycle of 1, 2 and 3 threads,
+    // through the compression stage (rebuilds, wall contacts), against arrays at every step.
+    Case c = bed_case(0.5);
+    FastOptions o;
+    o.min_parallel = 0;
+    o.prefetch_from = 0;
+    auto fast = make_fast_variant(o);
+    fast->init(c.setup);
+    VariantRun ref("arrays", c.setup);
+    Snapshot a, b;
+    std::string difference;
+    step_with_teams(*fast, c.state.step, 400, {{{3, 1, 2}, {1, 3}, {2, 3, 1, 1}}}, [&](std::int64_t k) {
+        ref.driver->step();
+        ref.variant->snapshot(a);
+        fast->snapshot(b);
+        if (difference.empty())
+            if (const auto d = first_difference(a, b)) difference = fmt::format("step {}: {}", k, d->describe());
+    });
+    EXPECT_EQ(difference, "");
+    EXPECT_GT(ref.variant->counts().particle_wall, 0);
+    EXPECT_GT(fast->rebuilds(), 5);
+}
+
+TEST(Fast, UnorderedForcesDoNotDependOnTheTeamsOfTheOtherPhases)
+{
+    // fast_unordered's bits depend on the force pass's team, not on those of predict() and the rebuild.
+    Case c = bed_case(0.5);
+    auto fixed = make_fast_variant(threaded_unordered()), varied = make_fast_variant(threaded_unordered());
+    fixed->init(c.setup);
+    varied->init(c.setup);
+    step_with_teams(*fixed, c.state.step, 300, {{{2}, {2}, {2}}}, [](std::int64_t) {});
+    step_with_teams(*varied, c.state.step, 300, {{{3, 1}, {1, 3, 2}, {2}}}, [](std::int64_t) {});
+    Snapshot a, b;
+    fixed->snapshot(a);
+    varied->snapshot(b);
+    const auto d = first_difference(a, b);
+    EXPECT_FALSE(d) << d->describe();
+}
+
+#ifdef _OPENMP
+TEST(Fast, DynamicTeamsGiveTheSameTrajectory)
+{
+    // OpenMP's own dynamic teams (their sizes follow the machine's load): bit-identical to arrays.
+    Case c = bed_case(0.5);
+    omp_set_dynamic(1);
+    const auto r = lockstep(c.setup, 300, {{FastOptions{}, 3}, {FastOptions{}, 2}});
+    omp_set_dynamic(0);
+    EXPECT_EQ(r.difference, "");
+}
+#endif
+
+TEST(Fast, ReportsTheThreadsItRunsOn)
+{
+    // Below min_parallel one thread whatever is asked; above, the force pass's team.
+    Case c = bed_case(0.5);
+    ASSERT_LT(c.state.size(), FastOptions{}.min_parallel);
+    set_threads(2);
+    VariantRun small(make_fast_variant(FastOptions{}), c.setup);
+    FastOptions threaded;
+    threaded.min_parallel = 0;
+    VariantRun big(make_fast_variant(threaded), c.setup);
+    small.driver->step();
+    big.driver->step();
+    EXPECT_EQ(small.variant->threads_used(), 1);
+#ifdef _OPENMP
+    EXPECT_EQ(big.variant->threads_used(), 2);
+#endif
+    set_threads(0);
+    EXPECT_EQ(VariantRun("arrays", c.setup).variant->threads_used(), 1);
 }

@@ -65,6 +65,9 @@ public:
     // The model features the instantiation picked in init() computes (model.hpp); a variant that does
     // not specialise runs the full model.
     virtual ModelFeatures model() const { return ModelFeatures::full(); }
+    // The threads the variant's phases really run on (a threaded variant may run fewer than asked, e.g.
+    // on one below a size threshold); what bench and run report.
+    virtual int threads_used() const { return 1; }
     // Whether init() honours this integrator and precision (scene.integrator, integrators.hpp); the
     // Driver refuses a run whose variant does not. A variant that integrates with the paper's Gear scheme
     // in double only keeps this default.

@@ -1,0 +1,232 @@
+#pragma once
+// The fast variant's canonical sums: each particle sums, in the order of physics.md §6, the slots where
+// it is j (partners of lower id, ascending), then its own slots (partners of higher id, ascending), then
+// its walls, so that its bits are those of arrays whichever thread sums it, and when. The slots come
+// from a thread's ring (the sweep, canonical_sweep.hpp) or from the list of all slots. At each rebuild
+// this plans, for the sweep, which chunk's slots each sum waits for, and cuts each chunk's schedule into
+// groups of kGroup particles summed side by side.
+#include <algorithm>
+#include <bit>
+#include <cstdint>
+#include <cstring>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "demmat/error.hpp"
+#include "heap_bytes.hpp"
+#include "neighbour_list.hpp"
+#include "pair_kernel.hpp"
+#include "particles.hpp"
+#include "wall_contacts.hpp"
+
+namespace demmat::fast {
+
+// Where a sum reads slot k: lo[k & mask] below `split`, hi[k & mask] from it on (a ring: mask + 1 slots,
+// plus one; the whole list: mask all ones).
+struct SlotSource {
+    const Slot* lo;
+    const Slot* hi;
+    std::size_t mask, split;
+};
+
+class CanonicalSums {
+public:
+    static constexpr std::size_t kChunk = 128;  // particles per chunk of the sweep
+    static constexpr int kGroup = 4;            // particles per sum group (sum_group)
+
+    // A group of sums (sum_group): its particles (-1: none), the longest of their lists as j and as i,
+    // and where its table starts in table_.
+    struct Group {
+        Index grain[kGroup] = {};
+        std::int32_t count = 0, as_j = 0, as_i = 0;
+        std::uint32_t table = 0;
+    };
+
+    // Per particle, the chunks of its slots' first and last owners; the particles by their last chunk
+    // (by_last, from last_start[chunk]) and by their first.
+    std::vector<Index> first_chunk, last_chunk, last_start, by_last, first_start, by_first;
+    // Each chunk's groups, of the two schedules (by last chunk, by first), from group_*_start[chunk].
+    std::vector<Group> groups_last, groups_first;
+    std::vector<Index> group_last_start, group_first_start;
+    // The most chunks and slots from a particle's first slot to its last (the sweep's reach): a ring of
+    // ring_slots slots (a power of two, at least that reach) holds every slot a sum reads.
+    std::size_t span_chunks = 0, ring_slots = 1;
+
+    static std::size_t chunks(std::size_t n) { return (n + kChunk - 1) / kChunk; }
+
+    // After a canonical list is built: a particle's sum needs the slots of the chunks from that of the
+    // first owner of its slots to that of the last (itself for its own, its partners of lower id for
+    // the others).
+    void plan(const NeighbourList& list, std::size_t n)
+    {
+        const Index* owner = list.owner.data();
+        const Index* jstart = list.jstart.data();
+        const Index* as_j = list.as_j.data();
+        const Index* pstart = list.start.data();
+        const std::size_t nch = chunks(n);
+        first_chunk.resize(n);
+        last_chunk.resize(n);
+        span_chunks = 0;
+        std::size_t reach = 0;  // the most slots from the start of a particle's first chunk to the end of its last
+        for (std::size_t s = 0; s < n; ++s) {
+            std::size_t first = s, last = s;
+            for (Index e = jstart[s]; e < jstart[s + 1]; ++e) {
+                const std::size_t o = std::size_t(owner[as_j[e]]);
+                first = std::min(first, o);
+                last = std::max(last, o);
+            }
+            first /= kChunk;
+            last /= kChunk;
+            first_chunk[s] = Index(first);
+            last_chunk[s] = Index(last);
+            span_chunks = std::max(span_chunks, last - first);
+            reach = std::max(reach, std::size_t(pstart[std::min(n, (last + 1) * kChunk)] - pstart[first * kChunk]));
+        }
+        ring_slots = std::bit_ceil(std::max<std::size_t>(reach, 1));
+        // The tables hold byte offsets into a ring as 32-bit words.
+        if ((ring_slots + 2) * sizeof(Slot) > std::size_t(UINT32_MAX))
+            throw CapacityError(fmt::format("the fast variant's canonical sweep needs a ring of {} slots, more than its 32-bit offsets "
+                                            "reach (a particle's partners are {} slots apart in storage)", ring_slots, reach));
+        bucket_sort(last_chunk, nch, last_start, by_last);
+        bucket_sort(first_chunk, nch, first_start, by_first);
+        table_.clear();
+        build_groups(list, by_last, last_start, nch, group_last_start, groups_last);
+        build_groups(list, by_first, first_start, nch, group_first_start, groups_first);
+    }
+
+    // Particle s's sum from `from`, its walls added, stored in p's f and t (Newton's law comes in the
+    // next step's pass, vectorised, with the corrector: here, a grain at a time, its scalar divisions
+    // would lengthen the force pass). The three components of a sum go as lanes of one quad (lane by
+    // lane, the scalar additions; x - y is x + (-y)), each read as the quad that starts at it in the slot:
+    // f, t_i and t_j are three consecutive values, and the fourth lane, the next value along, is not used.
+    void sum_particle(std::size_t s, const SlotSource& from, const NeighbourList& list, const WallContacts& walls, Particles& p) const
+    {
+        const double* lo = reinterpret_cast<const double*>(from.lo);
+        const double* hi = reinterpret_cast<const double*>(from.hi);
+        const std::size_t mask = from.mask, split = from.split;
+        auto at = [=](std::size_t k, std::size_t offset) { return (k < split ? lo : hi) + 9 * (k & mask) + offset; };
+        const Index* as_j = list.as_j.data();
+        Quad f{}, tq{};
+        for (Index e = list.jstart[s]; e < list.jstart[s + 1]; ++e) {
+            const std::size_t k = std::size_t(as_j[e]);
+            Quad q;
+            load_quad(q, at(k, 0));
+            f -= q;
+            load_quad(q, at(k, 6));
+            tq += q;
+        }
+        for (Index k = list.start[s]; k < list.start[s + 1]; ++k) {
+            Quad q;
+            load_quad(q, at(std::size_t(k), 0));
+            f += q;
+            load_quad(q, at(std::size_t(k), 3));
+            tq += q;
+        }
+        walls.add(s, f, tq);
+        p.store_sum(s, f, tq);
+    }
+
+    // The sums of a group of up to kGroup particles of one chunk's schedule, side by side: a chain of
+    // additions per particle, all from the ring. One particle's sum alone (sum_particle) is a chain of
+    // dependent additions ended by two loop exits whose trip counts no predictor learns; here the chains
+    // overlap and a group has two exits. The group's table (build_groups) holds the ring offsets in the
+    // canonical order, as j then as i, a row of kGroup a step; a particle's list that ends before the
+    // group's longest goes on with the ring's slot of zeros, which adds nothing (the sum starts at +0 and
+    // is never -0, and x + ±0 = x for every other x), so each particle's bits are those of sum_particle
+    // (the same order, kept there for the sums that read two rings or the list of all slots, which the
+    // tables' ring offsets cannot name).
+    void sum_group(const Group& g, const Slot* ring, const WallContacts& walls, Particles& p) const
+    {
+        const char* base = reinterpret_cast<const char*>(ring);
+        const char* ti = base + 3 * sizeof(double);  // where the torques start, for a slot at offset 0
+        const char* tj = base + 6 * sizeof(double);
+        auto add = [](Quad& sum, const char* at) {
+            Quad q;
+            std::memcpy(&q, at, sizeof(q));
+            sum += q;
+        };
+        auto subtract = [](Quad& sum, const char* at) {
+            Quad q;
+            std::memcpy(&q, at, sizeof(q));
+            sum -= q;
+        };
+        const std::uint32_t* row = table_.data() + g.table;
+        Quad f[kGroup]{}, tq[kGroup]{};
+        for (std::int32_t e = 0; e < g.as_j; ++e, row += kGroup)
+            for (int l = 0; l < kGroup; ++l) {
+                subtract(f[l], base + row[l]);
+                add(tq[l], tj + row[l]);
+            }
+        for (std::int32_t e = 0; e < g.as_i; ++e, row += kGroup)
+            for (int l = 0; l < kGroup; ++l) {
+                add(f[l], base + row[l]);
+                add(tq[l], ti + row[l]);
+            }
+        for (int l = 0; l < g.count; ++l) {
+            const std::size_t s = std::size_t(g.grain[l]);
+            walls.add(s, f[l], tq[l]);
+            p.store_sum(s, f[l], tq[l]);
+        }
+    }
+
+    std::size_t bytes() const
+    {
+        return heap_bytes(first_chunk, last_chunk, last_start, by_last, first_start, by_first, groups_last, groups_first, group_last_start,
+                          group_first_start, table_, bucket_);
+    }
+
+private:
+    // The groups of each chunk's schedule (the particles order[start[c] … start[c + 1]), sorted by their
+    // counts of slots as j, so that a group's lists are near one length), kGroup particles a group, and
+    // their tables in table_: a row of ring offsets a step, the lists as j to the group's longest, then
+    // as i, padded with the offset of the ring's slot of zeros (ring_slots).
+    void build_groups(const NeighbourList& list, const std::vector<Index>& order, const std::vector<Index>& start, std::size_t nch,
+                      std::vector<Index>& group_start, std::vector<Group>& groups)
+    {
+        const Index* jstart = list.jstart.data();
+        const Index* as_j = list.as_j.data();
+        const Index* pstart = list.start.data();
+        const std::size_t mask = ring_slots - 1;
+        auto offset = [mask](Index k) { return std::uint32_t((std::size_t(k) & mask) * sizeof(Slot)); };
+        const std::uint32_t zeros = std::uint32_t(ring_slots * sizeof(Slot));
+        group_start.assign(nch + 1, 0);
+        groups.clear();
+        for (std::size_t c = 0; c < nch; ++c) {
+            bucket_.assign(order.begin() + start[c], order.begin() + start[c + 1]);
+            std::sort(bucket_.begin(), bucket_.end(), [&](Index a, Index b) {
+                const Index la = jstart[a + 1] - jstart[a], lb = jstart[b + 1] - jstart[b];
+                return la != lb ? la < lb : a < b;
+            });
+            for (std::size_t g0 = 0; g0 < bucket_.size(); g0 += kGroup) {
+                Group g;
+                g.count = std::int32_t(std::min<std::size_t>(kGroup, bucket_.size() - g0));
+                g.table = std::uint32_t(table_.size());
+                for (int l = 0; l < kGroup; ++l) {
+                    const Index s = l < g.count ? bucket_[g0 + std::size_t(l)] : -1;
+                    g.grain[l] = s;
+                    if (s < 0) continue;
+                    g.as_j = std::max(g.as_j, jstart[s + 1] - jstart[s]);
+                    g.as_i = std::max(g.as_i, pstart[s + 1] - pstart[s]);
+                }
+                for (Index e = 0; e < g.as_j; ++e)
+                    for (int l = 0; l < kGroup; ++l) {
+                        const Index s = g.grain[l];
+                        table_.push_back(s >= 0 && e < jstart[s + 1] - jstart[s] ? offset(as_j[jstart[s] + e]) : zeros);
+                    }
+                for (Index e = 0; e < g.as_i; ++e)
+                    for (int l = 0; l < kGroup; ++l) {
+                        const Index s = g.grain[l];
+                        table_.push_back(s >= 0 && e < pstart[s + 1] - pstart[s] ? offset(pstart[s] + e) : zeros);
+                    }
+                groups.push_back(g);
+            }
+            group_start[c + 1] = Index(groups.size());
+        }
+    }
+
+    std::vector<std::uint32_t> table_;  // the groups' tables of ring offsets
+    std::vector<Index> bucket_;         // scratch: one chunk's particles while they are grouped
+};
+
+} // namespace demmat::fast

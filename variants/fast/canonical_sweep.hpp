@@ -1,0 +1,156 @@
+#pragma once
+// The fast variant's force pass in the canonical order: the pair kernel and the canonical sums in one
+// sweep over the storage order, a chunk at a time, so that each particle's slots are summed from a small
+// per-thread ring that stays in cache (slot k at k mod R), not from a list of them all, written to
+// memory and read back every step. A piece of the storage (one per two threads) is swept by two threads,
+// chunk by chunk, one upwards from its start and one downwards from its end, until they meet wherever
+// the machine lets them (neither waits for the other). After each chunk, the upward thread sums the
+// particles whose last slot (as i or as j) was in it, the downward one those whose first was. The others
+// straddle the meeting point or the end of a piece; they are summed after the sweep. Which thread sums a
+// particle, and when, changes no bit of its sum.
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "canonical_sums.hpp"
+#include "heap_bytes.hpp"
+#include "neighbour_list.hpp"
+#include "pair_kernel.hpp"
+#include "particles.hpp"
+#include "team.hpp"
+#include "wall_contacts.hpp"
+
+namespace demmat::fast {
+
+class CanonicalSweep {
+public:
+    struct Counts {
+        std::int64_t pairs = 0, walls = 0;  // contacts found
+        std::size_t team = 1;               // the threads that ran it
+    };
+
+    Counts run(const NeighbourList& list, const CanonicalSums& sums, WallContacts& walls, Particles& p, const ContactParams<double>& params,
+               bool prefetch, bool parallel)
+    {
+        constexpr std::size_t kChunk = CanonicalSums::kChunk;
+        const std::size_t n = p.n;
+        std::int64_t pp = 0, pw = 0;
+        std::size_t team = 1;
+        const Index* pstart = list.start.data();
+        const Index* by_last = sums.by_last.data();
+        const Index* last_start = sums.last_start.data();
+        const Index* first_chunk = sums.first_chunk.data();
+        const Index* last_chunk = sums.last_chunk.data();
+        const std::size_t chunks = CanonicalSums::chunks(n), span = sums.span_chunks, ring_slots = sums.ring_slots;
+        const std::size_t limit = std::size_t(thread_limit());
+        if (nclaims_ < limit) {
+            claims_ = std::make_unique<Claim[]>(limit);
+            nclaims_ = limit;
+        }
+        if (rings_.size() < limit) rings_.resize(limit);
+        const PairKernel kernel(list, p, params, prefetch);
+#pragma omp parallel reduction(+ : pp, pw) if (parallel)
+        {
+            const std::size_t nt = std::size_t(thread_count()), t = std::size_t(thread_index());
+            if (t == 0) team = nt;
+            // Two threads to a piece, one from each end; an odd thread count leaves the last piece one.
+            const std::size_t pieces = (nt + 1) / 2, pc = t / 2;
+            const bool down = t % 2 == 1;
+#pragma omp single
+            {
+                cut_pieces(list, pieces, chunks);
+                for (std::size_t q = 0; q < pieces; ++q) claims_[q].reset(piece_chunk_[q], piece_chunk_[q + 1]);
+                if (pieces > 1) all_.resize(list.pairs() + 1);  // + 1: a sum reads a quad from the last slot's t_j
+            }
+            std::vector<Slot>& ring = rings_[t];
+            // + 2: the slot of zeros at ring_slots (the groups' padding), and the quad the sums read from
+            // the last value of a slot (its fourth lane, unused), past the end.
+            if (ring.size() < ring_slots + 2) ring.assign(ring_slots + 2, Slot{});
+            ring[ring_slots] = ring[ring_slots + 1] = Slot{};  // a larger ring from before may hold slots there
+            // The kernel's records and every list of wall candidates are ready (predict(), or a rebuild).
+            pw += walls.compute(p, params);
+#pragma omp barrier
+            const std::size_t c0 = piece_chunk_[pc], c1 = piece_chunk_[pc + 1];
+            const SlotSink in_ring{ring.data(), ring_slots - 1, nullptr};
+            for (std::size_t ch; down ? claims_[pc].down(ch) : claims_[pc].up(ch);) {
+                // Slots near the end of a piece are also kept in all_, for the sums that straddle two pieces.
+                const bool edge = (pc > 0 && ch < c0 + span) || (pc + 1 < pieces && ch + span >= c1);
+                const SlotSink sink{in_ring.ring, in_ring.mask, edge ? all_.data() : nullptr};
+                pp += kernel.run<true>(std::size_t(pstart[ch * kChunk]), std::size_t(pstart[std::min(n, (ch + 1) * kChunk)]), nullptr, sink);
+                // The groups of this chunk's schedule; a group with a particle that straddles the end of
+                // the piece (three threads or more) goes a particle at a time, without that one.
+                const SlotSource from{in_ring.ring, in_ring.ring, in_ring.mask, 0};
+                const std::vector<CanonicalSums::Group>& groups = down ? sums.groups_first : sums.groups_last;
+                const Index* group_start = down ? sums.group_first_start.data() : sums.group_last_start.data();
+                for (Index q = group_start[ch]; q < group_start[ch + 1]; ++q) {
+                    const CanonicalSums::Group& g = groups[std::size_t(q)];
+                    auto inside = [&](Index s) {
+                        return down ? std::size_t(last_chunk[s]) < c1 : std::size_t(first_chunk[s]) >= c0;
+                    };
+                    bool all = true;
+                    for (int l = 0; l < g.count; ++l) all = all && inside(g.grain[l]);
+                    if (all) {
+                        sums.sum_group(g, in_ring.ring, walls, p);
+                        continue;
+                    }
+                    for (int l = 0; l < g.count; ++l)
+                        if (inside(g.grain[l])) sums.sum_particle(std::size_t(g.grain[l]), from, list, walls, p);
+                }
+            }
+#pragma omp barrier
+            {
+                // The particles of this piece that straddle its meeting point m (their last chunk is one of
+                // m … m + span, shared out between the piece's two threads): their slots below m are in the
+                // upward thread's ring, those from m on in the downward one's (each holds the last
+                // ring_slots it wrote, and no sum reaches over more). A piece of one thread met at its end.
+                const std::size_t m = claims_[pc].met();
+                const std::size_t up = down ? t - 1 : t, other = !down && t + 1 == nt ? t : up + 1;
+                const SlotSource split{rings_[up].data(), rings_[other].data(), ring_slots - 1, std::size_t(pstart[std::min(n, m * kChunk)])};
+                const std::size_t e1 = std::min(c1, m + span + 1), mid = m + (e1 - m) / 2;
+                for (std::size_t ch = down ? mid : m; ch < (down ? e1 : mid); ++ch)
+                    for (Index e = last_start[ch]; e < last_start[ch + 1]; ++e) {
+                        const std::size_t s = std::size_t(by_last[e]), f = std::size_t(first_chunk[s]);
+                        if (f >= c0 && f < m) sums.sum_particle(s, split, list, walls, p);
+                    }
+            }
+            if (!down && pc > 0) {
+                // Those whose first slot is in the piece before (all_ holds all the slots they read).
+                const SlotSource everything{all_.data(), all_.data(), ~std::size_t(0), 0};
+                const std::size_t b0 = piece_chunk_[pc - 1];
+                for (std::size_t ch = c0; ch < std::min(chunks, c0 + span + 1); ++ch)
+                    for (Index e = last_start[ch]; e < last_start[ch + 1]; ++e) {
+                        const std::size_t s = std::size_t(by_last[e]), f = std::size_t(first_chunk[s]);
+                        if (f >= b0 && f < c0) sums.sum_particle(s, everything, list, walls, p);
+                    }
+            }
+        }
+        return {pp, pw, team};
+    }
+
+    std::size_t bytes() const { return heap_bytes(piece_chunk_, rings_, all_) + nclaims_ * sizeof(Claim); }
+
+private:
+    // piece_chunk_[q], q = 0 … pieces: where each piece of the sweep starts, in chunks, cut so that the
+    // pieces hold about as many slots each.
+    void cut_pieces(const NeighbourList& list, std::size_t pieces, std::size_t chunks)
+    {
+        piece_chunk_.resize(pieces + 1);
+        const std::size_t total = list.pairs();
+        std::size_t ch = 0;
+        piece_chunk_[0] = 0;
+        for (std::size_t q = 1; q < pieces; ++q) {
+            const std::size_t want = total * q / pieces;
+            while (ch < chunks && std::size_t(list.start[ch * CanonicalSums::kChunk]) < want) ++ch;
+            piece_chunk_[q] = ch;
+        }
+        piece_chunk_[pieces] = chunks;
+    }
+
+    std::vector<std::size_t> piece_chunk_;
+    std::unique_ptr<Claim[]> claims_;  // per piece
+    std::size_t nclaims_ = 0;
+    std::vector<std::vector<Slot>> rings_;  // per thread
+    std::vector<Slot> all_;                 // every slot, where the sums that straddle two pieces read (several pieces)
+};
+
+} // namespace demmat::fast

@@ -1,0 +1,26 @@
+#pragma once
+// The heap bytes a part of the fast variant holds: each part sums its own containers next to their
+// declarations, and the variant's memory_bytes() sums the parts.
+#include <cstddef>
+
+namespace demmat::fast {
+
+// Vectors, and vectors of vectors (their own and their elements' heap).
+template <class C>
+std::size_t heap_bytes(const C& c)
+{
+    if constexpr (requires { c.front().capacity(); }) {
+        std::size_t b = c.capacity() * sizeof(c.front());
+        for (const auto& inner : c) b += heap_bytes(inner);
+        return b;
+    } else {
+        return c.capacity() * sizeof(typename C::value_type);
+    }
+}
+template <class... C>
+std::size_t heap_bytes(const C&... c)
+{
+    return (heap_bytes(c) + ...);
+}
+
+} // namespace demmat::fast

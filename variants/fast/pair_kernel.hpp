@@ -1,0 +1,181 @@
+#pragma once
+// The fast variant's pair kernel: a run of listed pairs (slots) through the contact law on lanes. Each
+// lane has the scalar law's bits (particle_contact_lanes is the scalar law's template code on packs), so
+// the contacts are those of arrays; what becomes of them is the caller's: written into their slots
+// (canonical order, summed later) or added to both particles' loads as they come (fast_unordered).
+#include <algorithm>
+#include <cstdint>
+#include <cstring>
+
+#include "demmat/contact_law.hpp"
+#include "neighbour_list.hpp"
+#include "particles.hpp"
+#include "quads.hpp"
+#include "wall_contacts.hpp"
+
+namespace demmat::fast {
+
+// One contact's result, kept in list order: force on i (on j it is -f), torque on i and on j.
+struct Slot {
+    Vec3d f, ti, tj;
+};
+static_assert(sizeof(Slot) == 9 * sizeof(double));
+
+// Where the canonical kernel puts slot k: ring[k & mask], a thread's ring of the slots its sweep has yet
+// to sum, and, where `all` is set, all[k] too (the whole list, for the sums that straddle two pieces).
+struct SlotSink {
+    Slot* ring = nullptr;
+    std::size_t mask = 0;
+    Slot* all = nullptr;
+    void put(std::size_t k, const Slot& v) const
+    {
+        ring[k & mask] = v;
+        if (all) all[k] = v;
+    }
+};
+
+class PairKernel {
+public:
+    // From FastOptions::prefetch_from particles on, the kernel prefetches its partners' records
+    // kPrefetch candidates ahead (and in fast_unordered their loads): owners come in storage order,
+    // which the hardware prefetches, partners from anywhere in the sweep's reach, which it does not, and
+    // in large beds the records no longer stay in the caches between force passes.
+    static constexpr std::size_t kPrefetch = 128;
+
+    PairKernel(const NeighbourList& list, const Particles& p, const ContactParams<double>& params, bool prefetch)
+        : owner_(list.owner.data()), partner_(list.partner.data()), pairs_(list.pairs()), kin_(p.kin.data()), params_(params),
+          prefetch_(prefetch)
+    {
+    }
+
+    // Slots [k0, k1): the contacts among them, each into its slot (canonical, through `sink`) or added to
+    // the loads of both particles (unordered). A canonical sum reads every slot of a particle, so there a
+    // pair out of contact holds zeros, which add nothing (a sum that starts at +0 is never -0, and
+    // x + ±0 = x for every other x), so the bits are those of arrays, which skips the pair; reading zeros
+    // costs less than a branch taken at random (a dropped pair's slot is zeroed every step: the ring's
+    // slot k & mask held another pair's). may_touch first, a cheap and conservative test (the law rejects
+    // every pair it rejects), so the skin's extra candidates cost a distance, not a pass through the law;
+    // the rest go through the law kLanes at a time. The test sorts the slots into kept and dropped
+    // without a branch (a third are dropped, in no pattern a predictor learns). Returns the contacts found.
+    template <bool Canonical>
+    std::int64_t run(std::size_t k0, std::size_t k1, Load* load, const SlotSink& sink = {}) const
+    {
+        std::size_t kept[kBlock], dropped[kBlock];
+        std::int64_t found = 0;
+        for (std::size_t c0 = k0; c0 < k1; c0 += kBlock) {
+            const std::size_t c1 = std::min(k1, c0 + kBlock);
+            std::size_t nk = 0, nd = 0;
+            std::size_t k = c0;
+            // kLanes candidates at a time: both records transposed into lanes, the test on the lanes
+            // (the remainder one by one).
+            for (; k + kLanes <= c1; k += kLanes) {
+                if (prefetch_) {
+                    const std::size_t ahead = std::min(k + kPrefetch, pairs_ - kLanes);
+                    for (int l = 0; l < kLanes; ++l) {
+                        const char* rec = reinterpret_cast<const char*>(&kin_[partner_[ahead + std::size_t(l)]]);
+                        __builtin_prefetch(rec);
+                        __builtin_prefetch(rec + 64);
+                        if constexpr (!Canonical) __builtin_prefetch(&load[partner_[ahead + std::size_t(l)]], 1);
+                    }
+                }
+                Lanes a[4], b[4];
+                gather_lanes([&](int l) -> const Quad& { return kin_[owner_[k + std::size_t(l)]].xr; }, a);
+                gather_lanes([&](int l) -> const Quad& { return kin_[partner_[k + std::size_t(l)]].xr; }, b);
+                const auto t = may_touch_lanes(Vec3<Lanes>{a[0], a[1], a[2]}, Vec3<Lanes>{b[0], b[1], b[2]}, a[3], b[3]);
+                for (int l = 0; l < kLanes; ++l) {
+                    kept[nk] = k + std::size_t(l);
+                    dropped[nd] = k + std::size_t(l);
+                    nk += std::size_t(t[l] != 0);
+                    nd += std::size_t(t[l] == 0);
+                }
+            }
+            for (; k < c1; ++k) {
+                const Quad& a = kin_[owner_[k]].xr;
+                const Quad& b = kin_[partner_[k]].xr;
+                const bool t = may_touch(Vec3d{a[0], a[1], a[2]}, Vec3d{b[0], b[1], b[2]}, a[3], b[3]);
+                kept[nk] = k;
+                dropped[nd] = k;
+                nk += std::size_t(t);
+                nd += std::size_t(!t);
+            }
+            if constexpr (Canonical)
+                for (std::size_t e = 0; e < nd; ++e) sink.put(dropped[e], Slot{});
+            for (std::size_t e = 0; e < nk; e += kLanes)
+                found += pack<Canonical>(kept + e, int(std::min<std::size_t>(kLanes, nk - e)), load, sink);
+        }
+        return found;
+    }
+
+private:
+    static constexpr std::size_t kBlock = 1024;  // candidates sorted into kept and dropped at a time
+
+    // The law for up to kLanes slots at once (unused lanes repeat the last slot and are not stored):
+    // both particles' records transposed into the lanes, particle_contact_lanes (the pair's coefficients
+    // computed from R and m in the lanes: cheaper than reading them from a per-pair array), and the lanes
+    // transposed back into the slots (zeros where h <= 0) or added to the loads.
+    template <bool Canonical>
+    int pack(const std::size_t* ks, int count, Load* load, const SlotSink& sink) const
+    {
+        std::size_t k[kLanes], s[kLanes], q[kLanes];
+        for (int l = 0; l < kLanes; ++l) {
+            k[l] = ks[l < count ? l : count - 1];
+            s[l] = std::size_t(owner_[k[l]]);
+            q[l] = std::size_t(partner_[k[l]]);
+        }
+        Lanes xi[4]{}, xj[4]{}, vi[4]{}, vj[4]{}, wi[4]{}, wj[4]{};
+        const Kin* kin = kin_;
+        gather_lanes([&](int l) -> const Quad& { return kin[s[l]].xr; }, xi);
+        gather_lanes([&](int l) -> const Quad& { return kin[q[l]].xr; }, xj);
+        gather_lanes([&](int l) -> const Quad& { return kin[s[l]].v; }, vi);
+        gather_lanes([&](int l) -> const Quad& { return kin[q[l]].v; }, vj);
+        gather_lanes([&](int l) -> const Quad& { return kin[s[l]].w; }, wi);
+        gather_lanes([&](int l) -> const Quad& { return kin[q[l]].w; }, wj);
+        ContactForce<Lanes> c;
+        const auto touch = particle_contact_lanes<FullModel>(
+            Vec3<Lanes>{xi[0], xi[1], xi[2]}, Vec3<Lanes>{xj[0], xj[1], xj[2]}, Vec3<Lanes>{vi[0], vi[1], vi[2]},
+            Vec3<Lanes>{vj[0], vj[1], vj[2]}, Vec3<Lanes>{wi[0], wi[1], wi[2]}, Vec3<Lanes>{wj[0], wj[1], wj[2]}, xi[3], xj[3], vi[3],
+            vj[3], params_, Coefficients<Lanes>{}, c);
+        int found = 0;
+        for (int l = 0; l < count; ++l) found += int(touch[l] != 0);
+        if constexpr (Canonical) {
+            // A slot is nine values: f, t_i, t_j; the first eight go as two quads, the ninth alone.
+            const Lanes g0[4] = {c.f_i.x, c.f_i.y, c.f_i.z, c.t_i.x}, g1[4] = {c.t_i.y, c.t_i.z, c.t_j.x, c.t_j.y};
+            Quad r0[kLanes], r1[kLanes];
+            lanes_to_rows<Lanes>(g0, r0);
+            lanes_to_rows<Lanes>(g1, r1);
+            for (int l = 0; l < count; ++l) {
+                Slot out;
+                char* bytes = reinterpret_cast<char*>(&out);
+                std::memcpy(bytes, &r0[l], sizeof(Quad));
+                std::memcpy(bytes + sizeof(Quad), &r1[l], sizeof(Quad));
+                out.tj.z = c.t_j.z[l];
+                sink.put(k[l], out);
+            }
+        } else {
+            // Added as they come, lane by lane (a particle may sit in several lanes).
+            const Lanes zero{};
+            const Lanes gf[4] = {c.f_i.x, c.f_i.y, c.f_i.z, zero}, gi[4] = {c.t_i.x, c.t_i.y, c.t_i.z, zero},
+                        gj[4] = {c.t_j.x, c.t_j.y, c.t_j.z, zero};
+            Quad f[kLanes], ti[kLanes], tj[kLanes];
+            lanes_to_rows<Lanes>(gf, f);
+            lanes_to_rows<Lanes>(gi, ti);
+            lanes_to_rows<Lanes>(gj, tj);
+            for (int l = 0; l < count; ++l) {
+                load[s[l]].f += f[l];
+                load[q[l]].f -= f[l];
+                load[s[l]].t += ti[l];
+                load[q[l]].t += tj[l];
+            }
+        }
+        return found;
+    }
+
+    const Index* owner_;
+    const Index* partner_;
+    std::size_t pairs_;
+    const Kin* kin_;
+    const ContactParams<double>& params_;
+    bool prefetch_;
+};
+
+} // namespace demmat::fast
