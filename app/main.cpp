@@ -83,7 +83,7 @@ std::int64_t steps_for(const Scene& scene, std::int64_t steps, double time)
     if (!(time >= 0.0) || !(time / scene.dt <= double(kMaxSteps)))
         throw Error(fmt::format("--time {:g} s is more than a run of Δt = {:g} s can reach in {} steps", time, scene.dt, kMaxSteps));
     if (steps < 1) throw Error(fmt::format("--steps {} is not a step count >= 1", steps));
-    if (time > 0.0) return std::max<std::int64_t>(1, std::int64_t(std::ceil(time / scene.dt - 1e-9)));  // integer steps, never accumulated time
+    if (time > 0.0) return std::max<std::int64_t>(1, steps_to_reach(time, scene.dt));
     return steps;
 }
 

@@ -19,6 +19,7 @@
 #include "demmat/error.hpp"
 #include "demmat/io.hpp"
 #include "demmat/output.hpp"
+#include "demmat/problem.hpp"
 #include "demmat/reference.hpp"
 #include "demmat/registry.hpp"
 #include "demmat/scenes.hpp"
@@ -77,34 +78,36 @@ struct NormalMotion {
 
 class Impact {
 public:
-    Impact(Scene scene, bool wall) : scene_(std::move(scene)), wall_(wall)
+    Impact(Scene scene, bool wall) : problem_(std::make_unique<Problem>(std::move(scene))), wall_(wall) {}
+    const Scene& scene() const { return problem_->scene(); }
+    const State& state() const { return problem_->state(); }
+    const Setup& setup() const { return problem_->setup(); }
+    // The same impact run with another time step and integrator.
+    void retime(double dt, const IntegratorChoice& integrator)
     {
-        state_ = initial_state(scene_);
-        setup_ = Setup::make(scene_, state_);
+        Scene s = scene();
+        s.dt = dt;
+        s.integrator = integrator;
+        problem_ = std::make_unique<Problem>(std::move(s), state());
     }
-    const Scene& scene() const { return scene_; }
-    Scene& scene() { return scene_; }
-    const State& state() const { return state_; }
-    const Setup& setup() const { return setup_; }
-    void refresh() { setup_ = Setup::make(scene_, state_); }
 
     // Normal motion from positions, velocities and the forces of the shared law (reference_forces).
     NormalMotion normal(const Frame& f) const
     {
         std::vector<Vec3d> force, torque;
-        reference_forces(f.x, f.v, f.w, state_.radius, setup_.mass, state_.walls, 0, scene_.dt, setup_.contact, force, torque);
+        reference_forces(f.x, f.v, f.w, state().radius, setup().mass, state().walls, 0, scene().dt, setup().contact, force, torque);
         if (wall_) {  // floor z = 0, normal +z; gravity is off in these scenes
-            const double h = state_.radius[0] - f.x[0].z;
-            return {h, -f.v[0].z, -(force[0].z / setup_.mass[0] + scene_.gravity.z)};
+            const double h = state().radius[0] - f.x[0].z;
+            return {h, -f.v[0].z, -(force[0].z / setup().mass[0] + scene().gravity.z)};
         }
         const Vec3d d = f.x[1] - f.x[0];
         const double dist = std::sqrt(dot(d, d));
         const Vec3d n = d / dist;
         const Vec3d vr = f.v[1] - f.v[0];
-        const Vec3d ar = force[1] / setup_.mass[1] - force[0] / setup_.mass[0];
+        const Vec3d ar = force[1] / setup().mass[1] - force[0] / setup().mass[0];
         const double vn = dot(vr, n);
         const Vec3d vp = vr - vn * n;
-        return {state_.radius[0] + state_.radius[1] - dist, -vn, -(dot(ar, n) + dot(vp, vp) / dist)};
+        return {state().radius[0] + state().radius[1] - dist, -vn, -(dot(ar, n) + dot(vp, vp) / dist)};
     }
 
     // Measures from a sampled trajectory (every step). Contact start and end come from the free flights
@@ -154,17 +157,17 @@ public:
     // `substeps` steps per Δt_obs; a different integrator from every scheme studied.
     std::vector<Frame> rk4(double dt, double t_end) const
     {
-        const std::size_t n = state_.size();
-        Frame f{0.0, state_.trans.x, state_.trans.v, state_.rot.v};
+        const std::size_t n = state().size();
+        Frame f{0.0, state().trans.x, state().trans.v, state().rot.v};
         std::vector<Frame> out{f};
         auto deriv = [&](const Frame& s, std::vector<Vec3d>& a, std::vector<Vec3d>& al) {
             std::vector<Vec3d> force, torque;
-            reference_forces(s.x, s.v, s.w, state_.radius, setup_.mass, state_.walls, 0, scene_.dt, setup_.contact, force, torque);
+            reference_forces(s.x, s.v, s.w, state().radius, setup().mass, state().walls, 0, scene().dt, setup().contact, force, torque);
             a.resize(n);
             al.resize(n);
             for (std::size_t i = 0; i < n; ++i) {
-                a[i] = force[i] / setup_.mass[i] + scene_.gravity;
-                al[i] = torque[i] / setup_.inertia[i];
+                a[i] = force[i] / setup().mass[i] + scene().gravity;
+                al[i] = torque[i] / setup().inertia[i];
             }
         };
         const auto steps = std::int64_t(std::ceil(t_end / dt));
@@ -199,9 +202,7 @@ public:
     }
 
 private:
-    Scene scene_;
-    State state_;
-    Setup setup_;
+    std::unique_ptr<Problem> problem_;  // replaced whole by retime(): its setup points into it
     bool wall_;
 };
 
@@ -291,7 +292,6 @@ void two_body_study(const Options& opt, std::vector<Row>& rows, json& refs)
         for (int n = 8; n <= 2048; n *= 2) per_tc.push_back(n);
 
     for (TwoBodyCase& c : two_body_cases()) {
-        c.impact.refresh();  // the setup points into the impact, which has moved into the list
         const State& st = c.impact.state();
         const Setup& su = c.impact.setup();
         const double r = st.radius[0];
@@ -339,9 +339,7 @@ void two_body_study(const Options& opt, std::vector<Row>& rows, json& refs)
             for (Precision prec : all_precisions) {
                 for (int n : per_tc) {
                     const double dt = tc / double(n);
-                    c.impact.scene().dt = dt;
-                    c.impact.scene().integrator = {scheme, prec};
-                    c.impact.refresh();
+                    c.impact.retime(dt, {scheme, prec});
                     const auto steps = std::int64_t(std::ceil(t_end / dt));
                     const Observed o = run_observed(c.impact.setup(), steps, 1);
                     Row base;

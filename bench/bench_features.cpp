@@ -38,6 +38,7 @@
 #include "demmat/error.hpp"
 #include "demmat/features.hpp"
 #include "demmat/output.hpp"
+#include "demmat/problem.hpp"
 #include "demmat/registry.hpp"
 #include "demmat/text.hpp"
 #include "demmat/scenes.hpp"
@@ -69,36 +70,21 @@ Scene mono_bed(std::int64_t n)
     return s;
 }
 
-State settled_state(const Scene& bed)
+State settled_bed(const Scene& bed)
 {
     const fs::path file = opt.states_dir / fmt::format("{}_settled.state", bed.name);
-    const auto steps = std::int64_t(std::ceil(kSettleTime / bed.dt - 1e-9));
-    try {
-        State st = load_state(file);
-        if (st.fingerprint == bed.fingerprint(st.size()) && st.step == steps) return st;
-    } catch (const Error&) {
-    }
-    std::cerr << fmt::format("bench_features: settling {} for {} s ({} steps; cached in {})\n", bed.name, kSettleTime, steps,
-                             file.string());
-    const State grid = initial_state(bed);
-    const Setup setup = Setup::make(bed, grid);
-    auto v = registry().find("arrays").create();
-    Driver d(*v, setup);
-    d.run(steps);
-    State st;
-    v->save(st);
-    st.dt = bed.dt;
-    st.fingerprint = grid.fingerprint;
-    fs::create_directories(opt.states_dir);
-    save_state(st, file);
-    return st;
+    const std::int64_t steps = steps_to_reach(kSettleTime, bed.dt);
+    return settled_state(bed, steps, file, registry().find("arrays").create, [&](std::int64_t k, std::int64_t total) {
+        if (k == 1)
+            std::cerr << fmt::format("bench_features: settling {} for {} s ({} steps; cached in {})\n", bed.name, kSettleTime, total,
+                                     file.string());
+    });
 }
 
 struct Level {
     int index;
     std::string name;
-    Scene scene;
-    State state;
+    std::unique_ptr<Problem> problem;
     ModelFeatures widen;  // level 5 only: the inert polydisperse kernel
 };
 
@@ -110,15 +96,15 @@ std::vector<std::unique_ptr<Level>> make_levels(const Scene& bed, const State& s
         auto l = std::make_unique<Level>();
         l->index = int(out.size());
         l->name = name;
-        l->scene = bed;
-        l->scene.name = bed.name + "_" + name;
-        change(l->scene);
-        l->state = settled;
+        Scene scene = bed;
+        scene.name = bed.name + "_" + name;
+        change(scene);
+        State state = settled;
         if (!spin)
-            for (std::vector<Vec3d>* q : {&l->state.rot.x, &l->state.rot.v, &l->state.rot.a, &l->state.rot.b3, &l->state.rot.b4,
-                                          &l->state.rot.b5})
+            for (std::vector<Vec3d>* q : {&state.rot.x, &state.rot.v, &state.rot.a, &state.rot.b3, &state.rot.b4, &state.rot.b5})
                 std::fill(q->begin(), q->end(), Vec3d{});
-        l->state.walls = continue_walls(l->scene, l->state);
+        state.walls = continue_walls(scene, state);
+        l->problem = std::make_unique<Problem>(std::move(scene), std::move(state));
         l->widen = widen;
         out.push_back(std::move(l));
     };
@@ -159,36 +145,34 @@ std::vector<std::unique_ptr<Level>> levels;
 
 void run_level(benchmark::State& st, const std::string& variant, const Level& level, bool full)
 {
-    Setup setup = Setup::make(level.scene, level.state);
-    setup.widen = full ? ModelFeatures::full() : level.widen;
+    Problem& p = *level.problem;
+    p.widen(full ? ModelFeatures::full() : level.widen);
     auto v = registry().find(variant).create();
-    Driver driver(*v, setup);
+    Driver driver(*v, p.setup());
     for (std::int64_t k = 0; k < kWarmup; ++k) driver.step();
     const PhaseTimes before = driver.times();
     double contacts = 0.0;
     for (auto _ : st) {
         driver.step();
-        const ContactCounts c = v->counts();
-        contacts += 2.0 * double(c.particle_particle) + double(c.particle_wall);
+        contacts += v->counts().per_particle(p.size());
     }
-    const PhaseTimes& t = driver.times();
-    const double steps = double(st.iterations());
-    const double n = double(level.state.size());
-    st.counters["predict_s"] = (t.predict - before.predict) / steps;
-    st.counters["search_s"] = (t.search - before.search) / steps;
-    st.counters["forces_s"] = (t.forces - before.forces) / steps;
-    st.counters["correct_s"] = (t.correct - before.correct) / steps;
-    st.counters["total_s"] = (t.total() - before.total()) / steps;
-    st.counters["us_per_particle_step"] = (t.total() - before.total()) / steps / n * 1e6;
-    st.counters["contacts_per_particle"] = contacts / steps / n;  // mean over the timed steps
+    const std::int64_t steps = st.iterations();
+    const PhaseTimes t = (driver.times() - before).per_step(steps);
+    st.counters["predict_s"] = t.predict;
+    st.counters["search_s"] = t.search;
+    st.counters["forces_s"] = t.forces;
+    st.counters["correct_s"] = t.correct;
+    st.counters["total_s"] = t.total();
+    st.counters["us_per_particle_step"] = t.total() / double(p.size()) * 1e6;
+    st.counters["contacts_per_particle"] = contacts / double(steps);  // mean over the timed steps
     const json label = {{"family", "features"},
                         {"variant", variant},
                         {"level", level.index},
                         {"level_name", level.name},
                         {"kernel", full ? "full" : "specialised"},
                         {"model", v->model().name()},
-                        {"scene_needs", features_of(level.scene, level.state).name()},
-                        {"particles", level.state.size()},
+                        {"scene_needs", features_of(p.scene(), p.state()).name()},
+                        {"particles", p.size()},
                         {"steps", st.iterations()}};
     st.SetLabel(label.dump());
 }
@@ -228,7 +212,7 @@ int main(int argc, char** argv)
     if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
     try {
         const Scene bed = mono_bed(opt.n);
-        const State settled = settled_state(bed);
+        const State settled = settled_bed(bed);
         levels = make_levels(bed, settled);
     } catch (const Error& e) {
         std::cerr << "bench_features: " << e.what() << "\n";

@@ -36,6 +36,7 @@
 #include "demmat/driver.hpp"
 #include "demmat/error.hpp"
 #include "demmat/output.hpp"
+#include "demmat/problem.hpp"
 #include "demmat/registry.hpp"
 #include "demmat/text.hpp"
 #include "demmat/scenes.hpp"
@@ -65,12 +66,6 @@ constexpr double settle_time = 0.4;
 enum class Start { loose, settled, compression };
 const char* start_name(Start s) { return s == Start::loose ? "loose" : s == Start::settled ? "settled" : "compression"; }
 
-struct Prepared {
-    Scene scene;
-    State state;
-    Setup setup;
-};
-
 // The variant that settles beds: the fastest bit-identical one built in, at all threads (any variant
 // gives the same state bit for bit; the tests check that).
 std::string settling_variant()
@@ -89,89 +84,60 @@ fs::path settled_file(std::int64_t n) { return opt.states_dir / fmt::format("ben
 void ensure_settled(std::int64_t n)
 {
     const Scene bed = dense_bed_scene(n);
-    const State grid = initial_state(bed);
-    const std::int64_t steps = std::int64_t(std::ceil(settle_time / bed.dt - 1e-9));
-    const fs::path file = settled_file(n);
-    if (fs::exists(file)) {
-        try {
-            const State s = load_state(file);
-            if (s.fingerprint == grid.fingerprint && s.step == steps) return;
-        } catch (const Error&) {
-        }
-        std::cerr << fmt::format("demmat_bench: {} is stale or damaged; settling again\n", file.string());
-    }
+    const std::int64_t steps = steps_to_reach(settle_time, bed.dt);
     const std::string name = settling_variant();
     set_threads(max_threads());
-    const bool threaded = registry().find(name).threaded;
-    std::cerr << fmt::format("demmat_bench: settling the dense bed of {} grains ({} steps of {}{}; cached in {})\n", n, steps,
-                             name, threaded ? fmt::format(", {} threads", max_threads()) : "", file.string());
-    const Setup setup = Setup::make(bed, grid);
-    auto v = registry().find(name).create();
-    Driver d(*v, setup);
     const auto start = std::chrono::steady_clock::now();
     auto last = start;
-    d.run(steps, [&](std::int64_t k) {
+    settled_state(bed, steps, settled_file(n), registry().find(name).create, [&](std::int64_t k, std::int64_t total) {
+        if (k == 1)
+            std::cerr << fmt::format("demmat_bench: settling the dense bed of {} grains ({} steps of {}, {} thread(s); cached in {})\n",
+                                     n, total, name, max_threads(), settled_file(n).string());
         const auto now = std::chrono::steady_clock::now();
         if (now - last > std::chrono::seconds(15)) {
             last = now;
             const double el = std::chrono::duration<double>(now - start).count();
-            std::cerr << fmt::format("demmat_bench:   step {}/{}, about {:.0f} s left\n", k, steps, el / double(k) * double(steps - k));
+            std::cerr << fmt::format("demmat_bench:   step {}/{}, about {:.0f} s left\n", k, total, el / double(k) * double(total - k));
         }
     });
-    State out;
-    v->save(out);
-    out.dt = bed.dt;
-    out.fingerprint = grid.fingerprint;
-    fs::create_directories(opt.states_dir);
-    save_state(out, file);
 }
 
-const Prepared& prepared(Start start, std::int64_t n)
+const Problem& prepared(Start start, std::int64_t n)
 {
-    static std::map<std::pair<int, std::int64_t>, std::unique_ptr<Prepared>> cache;
+    static std::map<std::pair<int, std::int64_t>, std::unique_ptr<Problem>> cache;
     auto& p = cache[{int(start), n}];
     if (p) return *p;
-    p = std::make_unique<Prepared>();
     const Scene bed = dense_bed_scene(n);
     switch (start) {
     case Start::loose:
-        p->scene = bed;
-        p->state = initial_state(bed);
+        p = std::make_unique<Problem>(bed);
         break;
-    case Start::settled:
+    case Start::settled: {
         ensure_settled(n);
-        p->scene = bed;
-        p->scene.grid.reset();
-        p->scene.state_file = settled_file(n);
-        p->state = initial_state(p->scene);
-        break;
-    case Start::compression:
-        ensure_settled(n);
-        p->scene = compression_scene(bed, settled_file(n));
-        p->state = initial_state(p->scene);
+        Scene s = bed;
+        s.grid.reset();
+        s.state_file = settled_file(n);
+        p = std::make_unique<Problem>(std::move(s));
         break;
     }
-    p->setup = Setup::make(p->scene, p->state);
+    case Start::compression:
+        ensure_settled(n);
+        p = std::make_unique<Problem>(compression_scene(bed, settled_file(n)));
+        break;
+    }
     return *p;
 }
 
 // The paper's literal scene (2 m box, N grains on a grid, random speeds) with a given search.
-struct PaperCase {
-    Scene scene;
-    State state;
-    Setup setup;
-};
-const PaperCase& paper_case(std::int64_t n, double cell_rmax)
+const Problem& paper_case(std::int64_t n, double cell_rmax)
 {
-    static std::map<std::pair<std::int64_t, double>, std::unique_ptr<PaperCase>> cache;
+    static std::map<std::pair<std::int64_t, double>, std::unique_ptr<Problem>> cache;
     auto& p = cache[{n, cell_rmax}];
     if (p) return *p;
-    p = std::make_unique<PaperCase>();
-    p->scene = paper_scene(n);
-    p->scene.search.method = cell_rmax > 0.0 ? SearchMethod::cells : SearchMethod::all_pairs;
-    if (cell_rmax > 0.0) p->scene.search.cell_size = cell_rmax;
-    p->state = initial_state(p->scene);
-    p->setup = Setup::make(p->scene, p->state);
+    Scene s = paper_scene(n);
+    s.search.method = cell_rmax > 0.0 ? SearchMethod::cells : SearchMethod::all_pairs;
+    if (cell_rmax > 0.0) s.search.cell_size = cell_rmax;
+    p = std::make_unique<Problem>(std::move(s));
     return *p;
 }
 
@@ -194,13 +160,11 @@ void time_steps(benchmark::State& st, const std::string& name, const Setup& setu
         pw += c.particle_wall;
         cand += c.candidates;
     }
-    const PhaseTimes& t = driver.times();
-    const double steps = double(st.iterations());
+    const std::int64_t steps = st.iterations();
     const double n = double(setup.state->size());
-    const double predict = (t.predict - before.predict) / steps, search = (t.search - before.search) / steps,
-                 forces = (t.forces - before.forces) / steps, correct = (t.correct - before.correct) / steps;
-    const double total = predict + search + forces + correct;
-    const double contacts = double(pp + pw) / steps, candidates = double(cand) / steps;
+    const PhaseTimes t = (driver.times() - before).per_step(steps);
+    const double predict = t.predict, search = t.search, forces = t.forces, correct = t.correct, total = t.total();
+    const double contacts = double(pp + pw) / double(steps), candidates = double(cand) / double(steps);
     st.counters["predict_s"] = predict;
     st.counters["search_s"] = search;
     st.counters["forces_s"] = forces;
@@ -208,13 +172,13 @@ void time_steps(benchmark::State& st, const std::string& name, const Setup& setu
     st.counters["search_plus_forces_s"] = search + forces;
     st.counters["total_s"] = total;
     st.counters["us_per_particle_step"] = total / n * 1e6;
-    st.counters["contacts_per_particle"] = (2.0 * double(pp) + double(pw)) / steps / n;
+    st.counters["contacts_per_particle"] = ContactCounts{pp, pw, 0}.per_particle(setup.state->size()) / double(steps);
     st.counters["candidates_per_particle"] = candidates / n;
     st.counters["forces_ns_per_contact"] = contacts > 0 ? forces / contacts * 1e9 : 0.0;
     st.counters["forces_ns_per_candidate"] = candidates > 0 ? forces / candidates * 1e9 : 0.0;
     st.counters["search_ns_per_candidate"] = candidates > 0 ? search / candidates * 1e9 : 0.0;
     st.counters["memory_bytes_per_particle"] = double(variant->memory_bytes()) / n;
-    st.counters["steps"] = steps;
+    st.counters["steps"] = double(steps);
     set_threads(max_threads());
 }
 
@@ -249,7 +213,7 @@ void register_phases()
                                       {"threads", t}, {"bitwise", v.bitwise}};
                     benchmark::RegisterBenchmark(nm.c_str(), [name = v.name, s, n, t, lab](benchmark::State& st) {
                         st.SetLabel(label(lab));
-                        time_steps(st, name, prepared(s, n).setup, t);
+                        time_steps(st, name, prepared(s, n).setup(), t);
                     })->Unit(benchmark::kMillisecond)->MinTime(n >= 100000 ? 2.0 : 0.5)->UseRealTime();
                 }
             }
@@ -270,7 +234,7 @@ void register_figure4()
                               {"search", search}, {"cell_size_rmax", cell}, {"threads", 1}};
             benchmark::RegisterBenchmark(nm.c_str(), [n, cell, lab](benchmark::State& st) {
                 st.SetLabel(label(lab));
-                time_steps(st, "arrays", paper_case(n, cell).setup, 1);
+                time_steps(st, "arrays", paper_case(n, cell).setup(), 1);
             })->Unit(benchmark::kMillisecond)->MinTime(0.3)->UseRealTime();
         }
 }
@@ -290,15 +254,16 @@ void register_cellsize()
                                   {"cell_size_rmax", cell}, {"threads", 1}};
                 benchmark::RegisterBenchmark(nm.c_str(), [name, n, cell, lab](benchmark::State& st) {
                     st.SetLabel(label(lab));
-                    static std::map<std::pair<std::int64_t, double>, std::unique_ptr<Prepared>> cache;
+                    static std::map<std::pair<std::int64_t, double>, std::unique_ptr<Problem>> cache;
                     auto& p = cache[{n, cell}];
                     if (!p) {
-                        p = std::make_unique<Prepared>(prepared(Start::settled, n));
-                        p->scene.search.method = SearchMethod::cells;
-                        p->scene.search.cell_size = cell;
-                        p->setup = Setup::make(p->scene, p->state);
+                        const Problem& bed = prepared(Start::settled, n);
+                        Scene s = bed.scene();
+                        s.search.method = SearchMethod::cells;
+                        s.search.cell_size = cell;
+                        p = std::make_unique<Problem>(std::move(s), bed.state());
                     }
-                    time_steps(st, name, p->setup, 1);
+                    time_steps(st, name, p->setup(), 1);
                 })->Unit(benchmark::kMillisecond)->MinTime(0.5)->UseRealTime();
             }
 }

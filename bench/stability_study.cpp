@@ -18,6 +18,7 @@
 #include "demmat/driver.hpp"
 #include "demmat/error.hpp"
 #include "demmat/io.hpp"
+#include "demmat/problem.hpp"
 #include "demmat/output.hpp"
 #include "demmat/registry.hpp"
 #include "demmat/scenes.hpp"
@@ -183,7 +184,7 @@ Outcome run_case(const CaseSpec& c, IntegratorChoice choice, double dt, const st
         const Setup setup = Setup::make(s, st);
         auto variant = registry().find(variant_name).create();
         Driver driver(*variant, setup);
-        o.steps = std::int64_t(std::ceil(c.t_end / dt - 1e-9));
+        o.steps = steps_to_reach(c.t_end, dt);
         driver.run(o.steps);
         Snapshot snap;
         variant->snapshot(snap);

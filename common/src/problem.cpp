@@ -1,5 +1,7 @@
 #include "demmat/problem.hpp"
 
+#include <cmath>
+
 #include "demmat/driver.hpp"
 #include "demmat/error.hpp"
 
@@ -16,6 +18,8 @@ std::unique_ptr<Problem> Problem::load(const std::filesystem::path& scene_file)
 {
     return std::make_unique<Problem>(load_scene(scene_file));
 }
+
+std::int64_t steps_to_reach(double time, double dt) { return std::int64_t(std::ceil(time / dt - 1e-9)); }
 
 State settled_state(const Scene& bed, std::int64_t steps, const std::filesystem::path& cache,
                     const std::function<std::unique_ptr<Variant>()>& make_variant,

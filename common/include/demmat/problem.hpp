@@ -27,12 +27,18 @@ public:
     const State& state() const { return state_; }
     const Setup& setup() const { return setup_; }
     std::size_t size() const { return state_.size(); }
+    // Features to model beyond what the scene needs (Setup::widen): tests of bit identity, feature costs.
+    void widen(const ModelFeatures& extra) { setup_.widen = extra; }
 
 private:
     Scene scene_;
     State state_;
     Setup setup_;
 };
+
+// The steps a run takes to reach `time` with steps of `dt`: integer steps, never accumulated time (the
+// 1e-9 forgives a quotient such as 0.4 / 1e-5 rounding to just above an integer).
+std::int64_t steps_to_reach(double time, double dt);
 
 // The one way to settle a bed: `steps` steps of a variant (made by `make_variant`, e.g. a registry
 // entry's `create`) from the scene's initial state, saved to `cache` and read back on the next call
