@@ -258,7 +258,7 @@ int cmd_run(const RunArgs& a)
                   {"variant", info.name},
                   {"model", {{"picked", variant->model().name()}, {"scene_needs", features_of(l->scene(), l->state()).name()}}},
                   {"steps", steps},
-                  {"threads", max_threads()},
+                  {"threads", variant->threads_used()},
                   {"end_time", driver.time()},
                   {"wall_seconds", wall},
                   {"steps_per_second", 1.0 / t.total()},
@@ -370,6 +370,7 @@ int cmd_bench(const BenchArgs& a)
     std::map<std::string, ContactCounts> counts;
     std::map<std::string, std::size_t> memory;
     std::map<std::string, std::string> model;  // the model instantiation each variant picked
+    std::map<std::string, int> used;           // the threads it really ran on (fast runs small beds on one)
     json reps = json::array();
     for (std::int64_t r = 0; r < a.repetitions; ++r) {
         // Interleaved, variants and thread counts alike, with the order rotated each repetition, so that
@@ -382,10 +383,12 @@ int cmd_bench(const BenchArgs& a)
             Driver driver(*variant, l->setup());
             const PhaseTimes t = measure_steps(driver, a.warmup, a.steps);
             const double v[4] = {t.predict, t.search, t.forces, t.correct};
+            used[key] = variant->threads_used();
             for (int p = 0; p < 4; ++p) {
                 samples[key][phases[p]].push_back(v[p]);
                 reps.push_back({{"variant", cfg.variant},
-                                {"threads", cfg.threads},
+                                {"threads", used[key]},
+                                {"threads_asked", cfg.threads},
                                 {"repetition", r},
                                 {"phase", phases[p]},
                                 {"seconds_per_step", v[p]}});
@@ -416,13 +419,14 @@ int cmd_bench(const BenchArgs& a)
                        {"max", *std::max_element(totals.begin(), totals.end())}};
         const ContactCounts& c = counts[key];
         summary.push_back({{"variant", cfg.variant},
-                           {"threads", cfg.threads},
+                           {"threads", used[key]},
+                           {"threads_asked", cfg.threads},
                            {"seconds_per_step", ph},
                            {"us_per_particle_step", tot_med / n * 1e6},
                            {"contacts_per_particle", c.per_particle(l->size())},
                            {"memory_bytes", memory[key]},
                            {"model", model[key]}});
-        std::cout << fmt::format("{:<{}} {:>7} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e} {:>10.4f}\n", cfg.variant, width, cfg.threads,
+        std::cout << fmt::format("{:<{}} {:>7} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e} {:>12.4e} {:>10.4f}\n", cfg.variant, width, used[key],
                                  ph["predict"]["median"].get<double>(), ph["search"]["median"].get<double>(),
                                  ph["forces"]["median"].get<double>(), ph["correct"]["median"].get<double>(), tot_med,
                                  tot_med / n * 1e6);
