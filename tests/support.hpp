@@ -16,15 +16,6 @@
 
 namespace demmat::test {
 
-// A scene with its initial state and setup, kept together (Setup points into the other two).
-struct Case {
-    Scene scene;
-    State state;
-    Setup setup;
-    explicit Case(Scene s) : scene(std::move(s)), state(initial_state(scene)), setup(Setup::make(scene, state)) {}
-    Case(Scene s, State st) : scene(std::move(s)), state(std::move(st)), setup(Setup::make(scene, state)) {}
-};
-
 inline std::vector<std::string> variant_names() { return registry().names(); }
 
 // The length of a long equivalence run (thousands of contact-rich steps). The sanitizer build
@@ -64,13 +55,13 @@ inline State settling_bed_state(const Scene& bed)
 
 // The settling bed as a scene that starts from the cached state; with `wall_speed` > 0, the paper's
 // compression stage (the x_max wall moving inwards), re-anchored at the state's step.
-inline Case bed_case(double wall_speed)
+inline Problem bed_case(double wall_speed)
 {
     const Scene bed = dense_bed_scene(2000);
     State st = settling_bed_state(bed);
     Scene s = wall_speed > 0 ? compression_scene(bed, "(cached state)", wall_speed) : bed;
     st.walls = continue_walls(s, st);
-    return Case(s, st);
+    return Problem(s, st);
 }
 
 // Turns a variant name into a valid test-name suffix.

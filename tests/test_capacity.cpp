@@ -24,7 +24,7 @@ const std::set<std::string> fixed_tables = {"arrays", "eigen_soa", "f90", "pasca
 bool contains(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
 
 // Particle 0 overlaps particles 1, 2 and 3: three partners j > 0.
-Case crowded(SearchMethod method, int pair_capacity, int wall_capacity, bool in_corner)
+Problem crowded(SearchMethod method, int pair_capacity, int wall_capacity, bool in_corner)
 {
     Scene s = head_on_scene();
     s.search.method = method;
@@ -44,23 +44,23 @@ Case crowded(SearchMethod method, int pair_capacity, int wall_capacity, bool in_
     }
     st.walls = s.walls;
     st.fingerprint = s.fingerprint(4);
-    return Case(s, st);
+    return Problem(s, st);
 }
 
 // One step of `variant` on the crowded case; either a CapacityError (returned) or the same snapshot and
 // contact counts as arrays with ample capacities.
 std::string step_or_match(const std::string& variant, SearchMethod method, int pair_cap, int wall_cap, bool corner)
 {
-    Case tight = crowded(method, pair_cap, wall_cap, corner);
-    VariantRun run(variant, tight.setup);
+    Problem tight = crowded(method, pair_cap, wall_cap, corner);
+    VariantRun run(variant, tight.setup());
     try {
         run.driver->step();
     } catch (const CapacityError& e) {
         return e.what();
     }
     EXPECT_FALSE(fixed_tables.count(variant)) << variant << " keeps fixed tables but did not stop on overflow";
-    Case ample = crowded(method, 64, 6, corner);
-    VariantRun ref("arrays", ample.setup);
+    Problem ample = crowded(method, 64, 6, corner);
+    VariantRun ref("arrays", ample.setup());
     ref.driver->step();
     const auto d = first_difference(ref.snapshot(), run.snapshot());
     EXPECT_FALSE(d) << variant << " went on past the capacity but computed something else: " << d->describe();
@@ -88,9 +88,9 @@ TEST_P(Capacities, ContactsPerParticleExactlyFull)
 {
     // Three partners in room for three: no overflow, and the result matches a roomy run.
     const auto [variant, method] = GetParam();
-    Case tight = crowded(method, 3, 6, false);
-    Case ample = crowded(method, 64, 6, false);
-    VariantRun run(variant, tight.setup), ref("arrays", ample.setup);
+    Problem tight = crowded(method, 3, 6, false);
+    Problem ample = crowded(method, 64, 6, false);
+    VariantRun run(variant, tight.setup()), ref("arrays", ample.setup());
     ASSERT_NO_THROW(run.driver->step());
     ref.driver->step();
     const auto d = first_difference(ref.snapshot(), run.snapshot());

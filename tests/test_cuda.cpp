@@ -22,23 +22,23 @@ namespace {
 
 // 400 grains settled for 15000 steps from the dense bed's loose grid (arrays), so the runs start with
 // contacts; with wall_speed > 0 the compression stage of that bed (the x_max wall moving inwards).
-Case small_bed(double wall_speed)
+Problem small_bed(double wall_speed)
 {
     static const Scene bed = dense_bed_scene(400);
     static const State settled = [] {
-        Case c(bed);
-        VariantRun run("arrays", c.setup);
+        Problem c(bed);
+        VariantRun run("arrays", c.setup());
         run.driver->run(15000);
         State st;
         run.variant->save(st);
         st.dt = bed.dt;
-        st.fingerprint = c.state.fingerprint;
+        st.fingerprint = c.state().fingerprint;
         return st;
     }();
     State st = settled;
     Scene s = wall_speed > 0 ? compression_scene(bed, "(settled in memory)", wall_speed) : bed;
     st.walls = continue_walls(s, st);
-    return Case(s, st);
+    return Problem(s, st);
 }
 
 struct Lockstep {
@@ -130,8 +130,8 @@ TEST(CudaHost, LaunchRunsEveryThreadOnceInShuffledBlockOrder)
 
 TEST(CudaHost, SettledBedIsBitIdenticalToArraysAtEveryStepForTwoShuffles)
 {
-    Case c = small_bed(0.0);
-    const Lockstep r = lockstep(c.setup, 300, two_shuffles());
+    Problem c = small_bed(0.0);
+    const Lockstep r = lockstep(c.setup(), 300, two_shuffles());
     EXPECT_EQ(r.difference, "");
     EXPECT_GT(r.counts.particle_particle, 400);  // a contact-rich bed, not a cloud
     EXPECT_GT(r.counts.particle_wall, 20);
@@ -139,9 +139,9 @@ TEST(CudaHost, SettledBedIsBitIdenticalToArraysAtEveryStepForTwoShuffles)
 
 TEST(CudaHost, CompressionStageIsBitIdenticalToArraysAtEveryStepForTwoShuffles)
 {
-    Case c = small_bed(0.5);
-    ASSERT_TRUE(c.scene.walls.size() > 0);
-    const Lockstep r = lockstep(c.setup, 300, two_shuffles());
+    Problem c = small_bed(0.5);
+    ASSERT_TRUE(c.scene().walls.size() > 0);
+    const Lockstep r = lockstep(c.setup(), 300, two_shuffles());
     EXPECT_EQ(r.difference, "");
     EXPECT_GT(r.counts.particle_particle, 400);
 }
@@ -150,23 +150,25 @@ TEST(CudaHost, AllPairsAndWideCellsGiveTheSameTrajectory)
 {
     // The device search (hashed cells, or every pair with no cells) cannot change the contact set.
     for (auto [method, cell] : {std::pair{SearchMethod::all_pairs, 2.0}, {SearchMethod::cells, 4.0}}) {
-        Case c = small_bed(0.0);
-        c.scene.search.method = method;
-        c.scene.search.cell_size = cell;
-        c.setup = Setup::make(c.scene, c.state);
+        const Problem bed = small_bed(0.0);
+        Scene s = bed.scene();
+        s.search.method = method;
+        s.search.cell_size = cell;
+        const Problem c(std::move(s), bed.state());
         std::vector<std::unique_ptr<Variant>> v;
         v.push_back(make_cuda_host_variant(7, 64));
-        EXPECT_EQ(lockstep(c.setup, 100, std::move(v)).difference, "") << "cell " << cell;
+        EXPECT_EQ(lockstep(c.setup(), 100, std::move(v)).difference, "") << "cell " << cell;
     }
 }
 
 TEST(CudaHost, CapacityOverflowStopsTheRunNamingTheCapacity)
 {
-    Case c = small_bed(0.0);
-    c.scene.capacity.contacts_per_particle = 2;
-    c.setup = Setup::make(c.scene, c.state);
+    const Problem bed = small_bed(0.0);
+    Scene s = bed.scene();
+    s.capacity.contacts_per_particle = 2;
+    const Problem c(std::move(s), bed.state());
     auto v = make_cuda_host_variant(1);
-    Driver d(*v, c.setup);
+    Driver d(*v, c.setup());
     try {
         d.step();
         FAIL() << "no capacity error";
@@ -199,13 +201,13 @@ TEST(Registry, AnUnavailableVariantIsListedApartWithItsReason)
 TEST(CudaDevice, SettledBedIsBitIdenticalToArraysAtEveryStep)
 {
     if (const std::string why = device_missing(); !why.empty()) GTEST_SKIP() << "cuda: " << why;
-    Case c = small_bed(0.0);
-    EXPECT_EQ(lockstep(c.setup, 300, device_run()).difference, "");
+    Problem c = small_bed(0.0);
+    EXPECT_EQ(lockstep(c.setup(), 300, device_run()).difference, "");
 }
 
 TEST(CudaDevice, CompressionStageIsBitIdenticalToArraysAtEveryStep)
 {
     if (const std::string why = device_missing(); !why.empty()) GTEST_SKIP() << "cuda: " << why;
-    Case c = small_bed(0.5);
-    EXPECT_EQ(lockstep(c.setup, 300, device_run()).difference, "");
+    Problem c = small_bed(0.5);
+    EXPECT_EQ(lockstep(c.setup(), 300, device_run()).difference, "");
 }

@@ -35,8 +35,8 @@ TEST_P(Equivalence, SearchMethodsGiveBitIdenticalTrajectories)
         Scene s = dense_bed_scene(1000);
         s.search.method = method;
         s.search.cell_size = cell;
-        Case c(s);
-        VariantRun run(GetParam(), c.setup);
+        Problem c(s);
+        VariantRun run(GetParam(), c.setup());
         run.driver->run(steps);
         EXPECT_GT(run.variant->counts().particle_particle, 200);
         finals.push_back(run.snapshot());
@@ -51,24 +51,24 @@ TEST_P(Equivalence, DenseBedIsBitIdenticalToArraysAtEveryStep)
 {
     if (GetParam() == "arrays") GTEST_SKIP() << "the reference itself";
     if (!registry().find(GetParam()).bitwise) GTEST_SKIP() << "drops the canonical order on purpose (its physics is tested elsewhere)";
-    Case c = bed_case(0.0);
-    EXPECT_EQ(compare({"arrays", GetParam()}, c.setup, long_run(5000)), "");
+    Problem c = bed_case(0.0);
+    EXPECT_EQ(compare({"arrays", GetParam()}, c.setup(), long_run(5000)), "");
 }
 
 TEST_P(Equivalence, CompressionStageIsBitIdenticalToArraysAtEveryStep)
 {
     if (GetParam() == "arrays") GTEST_SKIP() << "the reference itself";
     if (!registry().find(GetParam()).bitwise) GTEST_SKIP() << "drops the canonical order on purpose (its physics is tested elsewhere)";
-    Case c = bed_case(0.5);
-    EXPECT_EQ(compare({"arrays", GetParam()}, c.setup, long_run(3000)), "");
+    Problem c = bed_case(0.5);
+    EXPECT_EQ(compare({"arrays", GetParam()}, c.setup(), long_run(3000)), "");
 }
 
 TEST_P(Equivalence, PaperSceneIsBitIdenticalToArrays)
 {
     if (GetParam() == "arrays") GTEST_SKIP() << "the reference itself";
     if (!registry().find(GetParam()).bitwise) GTEST_SKIP() << "drops the canonical order on purpose (its physics is tested elsewhere)";
-    Case c(paper_scene());
-    EXPECT_EQ(compare({"arrays", GetParam()}, c.setup, 300), "");
+    Problem c(paper_scene());
+    EXPECT_EQ(compare({"arrays", GetParam()}, c.setup(), 300), "");
 }
 
 INSTANTIATE_TEST_SUITE_P(AllVariants, Equivalence, ::testing::ValuesIn(variant_names()),
@@ -96,11 +96,11 @@ TEST(Checker, ReportsTheFirstDifferenceWithUlps)
 TEST(Checker, DetectsADivergingVariant)
 {
     // Two runs of the same variant from states one ulp apart must be reported as different.
-    Case c(dense_bed_scene(300));
-    State other = c.state;
+    Problem c(dense_bed_scene(300));
+    State other = c.state();
     other.trans.x[17].x = std::nextafter(other.trans.x[17].x, 1.0);
-    Case d(c.scene, other);
-    VariantRun a("arrays", c.setup), b("arrays", d.setup);
+    Problem d(c.scene(), other);
+    VariantRun a("arrays", c.setup()), b("arrays", d.setup());
     a.driver->run(10);
     b.driver->run(10);
     const auto diff = first_difference(a.snapshot(), b.snapshot());

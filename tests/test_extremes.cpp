@@ -70,9 +70,9 @@ TEST_P(Extremes, SteelHeadOnMatchesHertz)
     s.dt = tc / 100.0;  // 2.5e-7 s, 0.06 of the Rayleigh time
     s.particles[0].position.x = -(r + hmax / 2);  // h_max apart: the contact starts after 0.35 t_c
     s.particles[1].position.x = r + hmax / 2;
-    Case c(s);
-    EXPECT_EQ(check_time_step(c.scene, c.state), "");
-    VariantRun run(GetParam(), c.setup);
+    Problem c(s);
+    EXPECT_EQ(check_time_step(c.scene(), c.state()), "");
+    VariantRun run(GetParam(), c.setup());
     double worst = 0.0;
     for (int k = 0; k < 400; ++k) {
         run.driver->step();
@@ -90,9 +90,9 @@ TEST(ExtremesCheck, SteelAtThePapersTimeStepIsRefused)
     Scene s = head_on_scene(1.0, 0.004);
     s.material = steel();
     s.dt = 1e-5;  // the paper's Δt: 2.3 Rayleigh times of a 4 mm steel grain
-    Case c(s);
+    Problem c(s);
     try {
-        check_time_step(c.scene, c.state);
+        check_time_step(c.scene(), c.state());
         ADD_FAILURE() << "a steel scene at the paper's time step was accepted";
     } catch (const Error& e) {
         EXPECT_TRUE(contains(e.what(), "exceeds the Rayleigh time")) << e.what();
@@ -107,9 +107,9 @@ TEST_P(Extremes, FiftyMetresPerSecondOnSteelIsResolved)
     const double v = 50.0, r = 0.004;
     const double m = sphere_mass(r, 7800.0), es = estar(2e11, 0.3);
     const double tc = hertz_contact_time(m, r, es, v), hmax = hertz_max_overlap(m, r, es, v);
-    Case c(wall_impact(steel(), v, r, hmax, tc / 50.0));
-    EXPECT_EQ(check_time_step(c.scene, c.state), "");
-    VariantRun run(GetParam(), c.setup);
+    Problem c(wall_impact(steel(), v, r, hmax, tc / 50.0));
+    EXPECT_EQ(check_time_step(c.scene(), c.state()), "");
+    VariantRun run(GetParam(), c.setup());
     double worst = 0.0;
     for (int k = 0; k < 200; ++k) {
         run.driver->step();
@@ -126,9 +126,9 @@ TEST(ExtremesCheck, FiftyMetresPerSecondWithATooLongStepIsRefused)
     Scene s = drop_scene(0.001, 0.004);
     s.particles[0].velocity = {0, 0, -50.0};
     s.dt = 5e-4;
-    Case c(s);
+    Problem c(s);
     try {
-        check_time_step(c.scene, c.state);
+        check_time_step(c.scene(), c.state());
         ADD_FAILURE() << "a step that crosses the wall was accepted";
     } catch (const Error& e) {
         const std::string m = e.what();
@@ -146,9 +146,9 @@ TEST_P(Extremes, AGrainThatCrossesAWallInOneStepIsCaught)
     // starts 1 mm above the floor and is 11 mm behind it after the predictor: the first check stops it.
     Scene s = wall_impact(steel(), 50.0, 0.004, 0.001, 2.4e-4);
     s.checks.interval = 1;
-    Case c(s);
-    EXPECT_THROW(check_time_step(c.scene, c.state), Error);
-    VariantRun run(GetParam(), c.setup);
+    Problem c(s);
+    EXPECT_THROW(check_time_step(c.scene(), c.state()), Error);
+    VariantRun run(GetParam(), c.setup());
     std::int64_t step = -1, particle = -1;
     const std::string m = run_error(run, 100, &step, &particle);
     EXPECT_EQ(step, 1) << m;
@@ -182,15 +182,15 @@ Scene mixture()
 
 TEST_P(Extremes, SizeRatioTenWithHundredsOfGrainsInACell)
 {
-    Case c(mixture());
-    EXPECT_EQ(c.setup.cell_size, 0.01);  // cells sized from the largest grain
-    EXPECT_EQ(check_time_step(c.scene, c.state), "");
+    Problem c(mixture());
+    EXPECT_EQ(c.setup().cell_size, 0.01);  // cells sized from the largest grain
+    EXPECT_EQ(check_time_step(c.scene(), c.state()), "");
     if (GetParam() != "arrays" && registry().find(GetParam()).bitwise) {
-        const CompareReport r = compare_variants({"arrays", GetParam()}, c.setup, 500);
+        const CompareReport r = compare_variants({"arrays", GetParam()}, c.setup(), 500);
         EXPECT_FALSE(r.difference) << r.difference->describe();
         return;  // arrays itself runs the checks below
     }
-    VariantRun run(GetParam(), c.setup);
+    VariantRun run(GetParam(), c.setup());
     EXPECT_EQ(run_error(run, 500), "");
     EXPECT_GT(run.variant->counts().particle_particle, 40);  // the block has landed on the big grain
 }
@@ -201,8 +201,8 @@ TEST(ExtremesCheck, SizeRatioTenSearchEqualsEveryPair)
     for (SearchMethod m : {SearchMethod::cells, SearchMethod::all_pairs}) {
         Scene s = mixture();
         s.search.method = m;
-        Case c(s);
-        VariantRun run("arrays", c.setup);
+        Problem c(s);
+        VariantRun run("arrays", c.setup());
         run.driver->run(500);
         out.push_back(run.snapshot());
     }
@@ -218,11 +218,11 @@ TEST_P(Extremes, SmallGrainRestsOnABigOneAtTheAnalyticOverlaps)
     s.name = "stack_1_10";
     s.material.gamma_n = 2000.0;
     s.particles = {{R, {0, 0, R + 1e-5}, {}, {}}, {r, {0, 0, 2 * R + r + 2e-5}, {}, {}}};
-    Case c(s);
-    VariantRun run(GetParam(), c.setup);
+    Problem c(s);
+    VariantRun run(GetParam(), c.setup());
     EXPECT_EQ(run_error(run, 10000), "");
     const Snapshot sn = run.snapshot();
-    const double mb = c.setup.mass[0], ms = c.setup.mass[1], es = c.setup.contact.estar_pp();
+    const double mb = c.setup().mass[0], ms = c.setup().mass[1], es = c.setup().contact.estar_pp();
     const double hw = std::pow(3.0 * (mb + ms) * 10.0 / (4.0 * es * std::sqrt(R)), 2.0 / 3.0);
     const double hp = std::pow(3.0 * ms * 10.0 / (4.0 * es * std::sqrt(R * r / (R + r))), 2.0 / 3.0);
     EXPECT_NEAR((R - sn.position[0].z) / hw, 1.0, 1e-5);
@@ -243,11 +243,11 @@ Scene elastic_box()
     return s;
 }
 
-double total_energy(const Snapshot& sn, const Case& c)
+double total_energy(const Snapshot& sn, const Problem& c)
 {
-    double e = kinetic_energy(sn, c.setup) +
-               elastic_energy(sn.position, c.state.radius, c.state.walls, sn.step, c.scene.dt, c.setup.contact);
-    for (std::size_t i = 0; i < sn.position.size(); ++i) e -= c.setup.mass[i] * dot(c.scene.gravity, sn.position[i]);
+    double e = kinetic_energy(sn, c.setup()) +
+               elastic_energy(sn.position, c.state().radius, c.state().walls, sn.step, c.scene().dt, c.setup().contact);
+    for (std::size_t i = 0; i < sn.position.size(); ++i) e -= c.setup().mass[i] * dot(c.scene().gravity, sn.position[i]);
     return e;
 }
 
@@ -255,14 +255,14 @@ double total_energy(const Snapshot& sn, const Case& c)
 
 TEST_P(Extremes, ZeroDampingEnergyDriftIsBoundedOver1e5Steps)
 {
-    Case c(elastic_box());
-    VariantRun run(GetParam(), c.setup);
+    Problem c(elastic_box());
+    VariantRun run(GetParam(), c.setup());
     Snapshot sn = run.snapshot();
-    sn.position = c.state.trans.x;  // before the first step the snapshot's forces are zero; positions are the state's
-    sn.velocity = c.state.trans.v;
+    sn.position = c.state().trans.x;  // before the first step the snapshot's forces are zero; positions are the state's
+    sn.velocity = c.state().trans.v;
     const double e0 = total_energy(sn, c);
-    double scale = kinetic_energy(sn, c.setup);  // + what gravity can trade across the box's height
-    for (double m : c.setup.mass) scale += m * 10.0 * (c.scene.domain.max.z - c.scene.domain.min.z);
+    double scale = kinetic_energy(sn, c.setup());  // + what gravity can trade across the box's height
+    for (double m : c.setup().mass) scale += m * 10.0 * (c.scene().domain.max.z - c.scene().domain.min.z);
     double worst = 0.0;
     std::int64_t contacts = 0;
     for (int block = 0; block < 100; ++block) {
@@ -285,9 +285,9 @@ TEST_P(Extremes, OverdampedContactGainsNoEnergyAndDoesNotStick)
     s.material.gamma_n = 25600.0;
     s.dt = 2e-6;
     s.checks.interval = 1;
-    Case c(s);
-    VariantRun run(GetParam(), c.setup);
-    const double es = c.setup.contact.estar_pp();
+    Problem c(s);
+    VariantRun run(GetParam(), c.setup());
+    const double es = c.setup().contact.estar_pp();
     double last = INFINITY, hmax = 0.0, prev_h = -1.0;
     bool past_max = false;
     for (int k = 0; k < 5000; ++k) {
@@ -295,7 +295,7 @@ TEST_P(Extremes, OverdampedContactGainsNoEnergyAndDoesNotStick)
         const Snapshot sn = run.snapshot();
         const Vec3d d = sn.position[1] - sn.position[0];
         const double h = 2 * r - std::sqrt(dot(d, d));
-        const double e = kinetic_energy(sn, c.setup) + (h > 0 ? 0.4 * es * 4.0 / 3.0 * std::sqrt(r / 2) * h * h * std::sqrt(h) : 0.0);
+        const double e = kinetic_energy(sn, c.setup()) + (h > 0 ? 0.4 * es * 4.0 / 3.0 * std::sqrt(r / 2) * h * h * std::sqrt(h) : 0.0);
         ASSERT_LE(e, last * (1 + 1e-12)) << "energy grew at step " << k + 1;
         last = e;
         ASSERT_LE(sn.force[0].x, 0.0) << "attraction at step " << k + 1;  // the force on 0 points away from 1
@@ -311,7 +311,7 @@ TEST_P(Extremes, OverdampedContactGainsNoEnergyAndDoesNotStick)
     const double e = (sn.velocity[1].x - sn.velocity[0].x) / v;
     EXPECT_GE(e, 0.0);
     EXPECT_LT(e, 0.05);
-    EXPECT_LT(hmax, hertz_max_overlap(c.setup.mass[0] / 2, r / 2, es, v));  // damping shortens the approach
+    EXPECT_LT(hmax, hertz_max_overlap(c.setup().mass[0] / 2, r / 2, es, v));  // damping shortens the approach
 }
 
 // ---- grains that leave the domain ---------------------------------------------------------------------------
@@ -326,10 +326,10 @@ TEST_P(Extremes, AGrainLeavingThroughAnOpenSideFliesOn)
     s.walls.clear();
     s.particles[0].velocity = {1.0, 0.0, 0.0};
     s.dt = 1e-4;
-    Case c(s);
-    VariantRun run(GetParam(), c.setup);
+    Problem c(s);
+    VariantRun run(GetParam(), c.setup());
     ASSERT_EQ(run_error(run, 25000), "");
-    const double t = 25000 * c.scene.dt;
+    const double t = 25000 * c.scene().dt;
     const Snapshot sn = run.snapshot();
     EXPECT_NEAR(sn.position[0].x, t, 1e-9);
     EXPECT_NEAR(sn.position[0].z, 0.054 - 5.0 * t * t, 1e-8);
@@ -342,8 +342,8 @@ TEST_P(Extremes, AClosedBoxKeepsItsGrains)
     Scene s = drop_scene(0.05, 0.004);
     s.walls = box_walls(s.domain);
     s.particles[0].velocity = {1.0, 0.0, 0.0};
-    Case c(s);
-    VariantRun run(GetParam(), c.setup);
+    Problem c(s);
+    VariantRun run(GetParam(), c.setup());
     ASSERT_EQ(run_error(run, 35000), "");
     const Snapshot sn = run.snapshot();
     for (int a = 0; a < 3; ++a) {
@@ -363,8 +363,8 @@ TEST_P(Extremes, EnergyGrowthIsDetected)
     const double m = sphere_mass(r, 1000.0);
     s.dt = 0.22 * hertz_contact_time(m / 2, r / 2, s.contact_params().estar_pp(), v);
     s.checks.interval = 1;
-    Case c(s);
-    VariantRun run(GetParam(), c.setup);
+    Problem c(s);
+    VariantRun run(GetParam(), c.setup());
     std::int64_t step = -1, particle = -1;
     const std::string msg = run_error(run, 100, &step, &particle);
     EXPECT_TRUE(contains(msg, "exceeds the start energy plus the work of gravity")) << msg;
@@ -377,8 +377,8 @@ TEST_P(Extremes, EnergyGrowthIsDetected)
 TEST(ExtremesCheck, StandardScenesPassTheTimeStepChecks)
 {
     for (const Scene& s : {paper_scene(), dense_bed_scene(2000), head_on_scene(), drop_scene()}) {
-        Case c(s);
-        EXPECT_EQ(check_time_step(c.scene, c.state), "") << s.name;
+        Problem c(s);
+        EXPECT_EQ(check_time_step(c.scene(), c.state()), "") << s.name;
     }
 }
 

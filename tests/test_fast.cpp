@@ -120,9 +120,9 @@ void step_with_teams(Variant& variant, std::int64_t first_step, std::int64_t ste
 
 TEST(Fast, DenseBedIsBitIdenticalToArraysAtOneAndTwoThreads)
 {
-    Case c = bed_case(0.0);
-    ASSERT_GE(c.state.size(), 2000u);
-    const auto r = lockstep(c.setup, long_run(5000), {{FastOptions{}, 1}, {FastOptions{}, 2}});
+    Problem c = bed_case(0.0);
+    ASSERT_GE(c.state().size(), 2000u);
+    const auto r = lockstep(c.setup(), long_run(5000), {{FastOptions{}, 1}, {FastOptions{}, 2}});
     EXPECT_EQ(r.difference, "");
     EXPECT_GT(r.contacts, 3000);  // contact-rich: > 3 contacts per particle
 }
@@ -131,10 +131,10 @@ TEST(Fast, CompressionStageIsBitIdenticalToArraysWhileTheListIsRebuilt)
 {
     // Grains still falling and the wall moving in: with a skin of 0.1·R_max (0.5 mm) the list is
     // rebuilt, and the particles re-sorted, every ten to twenty steps.
-    Case c = bed_case(0.5);
+    Problem c = bed_case(0.5);
     FastOptions thin;
     thin.skin = 0.1;
-    const auto r = lockstep(c.setup, long_run(3000), {{thin, 1}, {thin, 2}});
+    const auto r = lockstep(c.setup(), long_run(3000), {{thin, 1}, {thin, 2}});
     EXPECT_EQ(r.difference, "");
     ASSERT_EQ(r.rebuilds.size(), 2u);
     EXPECT_GE(r.rebuilds[0], 20) << "the displacement check never asked for a rebuild";
@@ -145,13 +145,13 @@ TEST(Fast, AnySkinAndThreadCountGiveTheSameTrajectory)
 {
     // No skin (a rebuild every step), a wide skin (rare rebuilds, 3x the candidates), and an odd thread
     // count that splits the particles unevenly.
-    Case c = bed_case(0.5);
+    Problem c = bed_case(0.5);
     const std::int64_t steps = 600;
     FastOptions none;
     none.skin = 0.0;
     FastOptions wide;
     wide.skin = 1.0;
-    const auto r = lockstep(c.setup, steps, {{none, 3}, {wide, 2}, {wide, 1}});
+    const auto r = lockstep(c.setup(), steps, {{none, 3}, {wide, 2}, {wide, 1}});
     EXPECT_EQ(r.difference, "");
     ASSERT_EQ(r.rebuilds.size(), 3u);
     EXPECT_EQ(r.rebuilds[0], steps + 1) << "no skin: every step must rebuild";
@@ -163,9 +163,9 @@ TEST(Fast, MoreWallsThanTheNearWallBitsGiveTheSameTrajectory)
     // fast marks the walls a grain may touch a bit per wall up to 8 walls and tests each wall again
     // beyond. Four walls that touch nothing (the side walls moved 5 cm out) put in front of the box's
     // six make ten, with the floor (z_min, the most contacts) at index 8, past the bits.
-    Case c = bed_case(0.5);
-    Scene s = c.scene;
-    State st = c.state;
+    Problem c = bed_case(0.5);
+    Scene s = c.scene();
+    State st = c.state();
     std::vector<Wall> far;
     for (const Wall& w : st.walls) {
         if (w.name == "z_min" || w.name == "z_max") continue;
@@ -178,8 +178,8 @@ TEST(Fast, MoreWallsThanTheNearWallBitsGiveTheSameTrajectory)
     st.walls.insert(st.walls.begin(), far.begin(), far.end());
     s.walls.insert(s.walls.begin(), far.begin(), far.end());
     ASSERT_EQ(st.walls[8].name, "z_min");
-    Case many(s, st);
-    const auto r = lockstep(many.setup, 300, {{FastOptions{}, 1}, {FastOptions{}, 2}});
+    Problem many(s, st);
+    const auto r = lockstep(many.setup(), 300, {{FastOptions{}, 1}, {FastOptions{}, 2}});
     EXPECT_EQ(r.difference, "");
 }
 
@@ -189,9 +189,9 @@ TEST(Fast, UnorderedDiffersFromArraysOnlyByTheSummationOrder)
     // another order. A sum of k terms reordered moves by at most about k·ε·Σ|terms| (ε = 1.1e-16, k ≤ 16
     // here); 1e-11 of the largest force leaves a margin of 10³ over that, and is far below any
     // physical difference: one contact missed or added changes a force by that contact's own size.
-    Case c = bed_case(0.5);
+    Problem c = bed_case(0.5);
     set_threads(2);
-    VariantRun ref("arrays", c.setup), unordered(make_fast_variant(threaded_unordered()), c.setup);
+    VariantRun ref("arrays", c.setup()), unordered(make_fast_variant(threaded_unordered()), c.setup());
     ref.driver->step();
     unordered.driver->step();
     const Snapshot a = ref.snapshot(), b = unordered.snapshot();
@@ -216,7 +216,7 @@ TEST(Fast, UnorderedDiffersFromArraysOnlyByTheSummationOrder)
     std::vector<std::unique_ptr<VariantRun>> others;
     for (int threads : {1, 3}) {
         set_threads(threads);
-        others.push_back(std::make_unique<VariantRun>(make_fast_variant(threaded_unordered()), c.setup));
+        others.push_back(std::make_unique<VariantRun>(make_fast_variant(threaded_unordered()), c.setup()));
         others.back()->driver->step();
     }
     auto largest_gap = [](const Snapshot& x, const Snapshot& y) {
@@ -250,9 +250,9 @@ TEST(Fast, UnorderedDiffersFromArraysOnlyByTheSummationOrder)
 TEST(Fast, UnorderedIsDeterministicForAFixedThreadCount)
 {
     // Not promised across thread counts, but a fixed partition sums in a fixed order: two runs agree.
-    Case c = bed_case(0.5);
+    Problem c = bed_case(0.5);
     set_threads(2);
-    VariantRun one(make_fast_variant(threaded_unordered()), c.setup), two(make_fast_variant(threaded_unordered()), c.setup);
+    VariantRun one(make_fast_variant(threaded_unordered()), c.setup()), two(make_fast_variant(threaded_unordered()), c.setup());
     for (int k = 0; k < 300; ++k) {
         one.driver->step();
         two.driver->step();
@@ -268,16 +268,16 @@ TEST(Fast, PhasesOnTeamsOfDifferentSizesGiveTheSameTrajectory)
     // with OpenMP's dynamic teams (omp_set_dynamic, OMP_DYNAMIC=true) the two may run on teams of
     // different sizes, which must change no bit. Every phase here on its own cycle of 1, 2 and 3 threads,
     // through the compression stage (rebuilds, wall contacts), against arrays at every step.
-    Case c = bed_case(0.5);
+    Problem c = bed_case(0.5);
     FastOptions o;
     o.min_parallel = 0;
     o.prefetch_from = 0;
     auto fast = make_fast_variant(o);
-    fast->init(c.setup);
-    VariantRun ref("arrays", c.setup);
+    fast->init(c.setup());
+    VariantRun ref("arrays", c.setup());
     Snapshot a, b;
     std::string difference;
-    step_with_teams(*fast, c.state.step, 400, {{{3, 1, 2}, {1, 3}, {2, 3, 1, 1}}}, [&](std::int64_t k) {
+    step_with_teams(*fast, c.state().step, 400, {{{3, 1, 2}, {1, 3}, {2, 3, 1, 1}}}, [&](std::int64_t k) {
         ref.driver->step();
         ref.variant->snapshot(a);
         fast->snapshot(b);
@@ -292,12 +292,12 @@ TEST(Fast, PhasesOnTeamsOfDifferentSizesGiveTheSameTrajectory)
 TEST(Fast, UnorderedForcesDoNotDependOnTheTeamsOfTheOtherPhases)
 {
     // fast_unordered's bits depend on the force pass's team, not on those of predict() and the rebuild.
-    Case c = bed_case(0.5);
+    Problem c = bed_case(0.5);
     auto fixed = make_fast_variant(threaded_unordered()), varied = make_fast_variant(threaded_unordered());
-    fixed->init(c.setup);
-    varied->init(c.setup);
-    step_with_teams(*fixed, c.state.step, 300, {{{2}, {2}, {2}}}, [](std::int64_t) {});
-    step_with_teams(*varied, c.state.step, 300, {{{3, 1}, {1, 3, 2}, {2}}}, [](std::int64_t) {});
+    fixed->init(c.setup());
+    varied->init(c.setup());
+    step_with_teams(*fixed, c.state().step, 300, {{{2}, {2}, {2}}}, [](std::int64_t) {});
+    step_with_teams(*varied, c.state().step, 300, {{{3, 1}, {1, 3, 2}, {2}}}, [](std::int64_t) {});
     Snapshot a, b;
     fixed->snapshot(a);
     varied->snapshot(b);
@@ -309,9 +309,9 @@ TEST(Fast, UnorderedForcesDoNotDependOnTheTeamsOfTheOtherPhases)
 TEST(Fast, DynamicTeamsGiveTheSameTrajectory)
 {
     // OpenMP's own dynamic teams (their sizes follow the machine's load): bit-identical to arrays.
-    Case c = bed_case(0.5);
+    Problem c = bed_case(0.5);
     omp_set_dynamic(1);
-    const auto r = lockstep(c.setup, 300, {{FastOptions{}, 3}, {FastOptions{}, 2}});
+    const auto r = lockstep(c.setup(), 300, {{FastOptions{}, 3}, {FastOptions{}, 2}});
     omp_set_dynamic(0);
     EXPECT_EQ(r.difference, "");
 }
@@ -320,13 +320,13 @@ TEST(Fast, DynamicTeamsGiveTheSameTrajectory)
 TEST(Fast, ReportsTheThreadsItRunsOn)
 {
     // Below min_parallel one thread whatever is asked; above, the force pass's team.
-    Case c = bed_case(0.5);
-    ASSERT_LT(c.state.size(), FastOptions{}.min_parallel);
+    Problem c = bed_case(0.5);
+    ASSERT_LT(c.state().size(), FastOptions{}.min_parallel);
     set_threads(2);
-    VariantRun small(make_fast_variant(FastOptions{}), c.setup);
+    VariantRun small(make_fast_variant(FastOptions{}), c.setup());
     FastOptions threaded;
     threaded.min_parallel = 0;
-    VariantRun big(make_fast_variant(threaded), c.setup);
+    VariantRun big(make_fast_variant(threaded), c.setup());
     small.driver->step();
     big.driver->step();
     EXPECT_EQ(small.variant->threads_used(), 1);
@@ -334,5 +334,5 @@ TEST(Fast, ReportsTheThreadsItRunsOn)
     EXPECT_EQ(big.variant->threads_used(), 2);
 #endif
     set_threads(0);
-    EXPECT_EQ(VariantRun("arrays", c.setup).variant->threads_used(), 1);
+    EXPECT_EQ(VariantRun("arrays", c.setup()).variant->threads_used(), 1);
 }

@@ -57,13 +57,13 @@ struct Outcome {
     std::int64_t max_pp = 0, max_pw = 0;
 };
 
-Outcome specialised_vs_general(const std::string& name, const Case& c, ModelFeatures widen, std::int64_t steps,
+Outcome specialised_vs_general(const std::string& name, const Problem& c, ModelFeatures widen, std::int64_t steps,
                                double general_gamma_n = -1.0)
 {
-    Setup general = c.setup;
+    Setup general = c.setup();
     general.widen = widen;
     if (general_gamma_n >= 0.0) general.contact.gamma_n = general_gamma_n;  // only for the control test
-    VariantRun a(name, c.setup), b(name, general);
+    VariantRun a(name, c.setup()), b(name, general);
     Outcome o;
     o.specialised = a.variant->model();
     o.general = b.variant->model();
@@ -95,14 +95,14 @@ Scene small_bed() { return dense_bed_scene(343); }
 // contact-rich state (about 4 contacts per grain, a quarter of them with walls) for the tests below to
 // start from, made once per process. The tests change the scene's physics; `spin` false clears the
 // rotational Gear state, so that a frictionless scene needs no rotation.
-Case settled_bed(Scene scene, bool monodisperse, bool spin)
+Problem settled_bed(Scene scene, bool monodisperse, bool spin)
 {
     static std::map<bool, State> cache;
     if (!cache.count(monodisperse)) {
         Scene base = small_bed();
         if (monodisperse) base.grid->radius_min = base.grid->radius_max;
-        Case c(base);
-        VariantRun run("arrays", c.setup);
+        Problem c(base);
+        VariantRun run("arrays", c.setup());
         run.driver->run(20000);
         State st;
         run.variant->save(st);
@@ -113,7 +113,7 @@ Case settled_bed(Scene scene, bool monodisperse, bool spin)
         for (std::vector<Vec3d>* q : {&st.rot.x, &st.rot.v, &st.rot.a, &st.rot.b3, &st.rot.b4, &st.rot.b5})
             std::fill(q->begin(), q->end(), Vec3d{});
     st.walls = continue_walls(scene, st);
-    return Case(std::move(scene), std::move(st));
+    return Problem(std::move(scene), std::move(st));
 }
 
 std::filesystem::path source_dir() { return DEMMAT_SOURCE_DIR; }
@@ -224,10 +224,10 @@ TEST(ModelChoice, NoVariantEverModelsLessThanItsSceneNeeds)
         if ((b & 12) == 12) s.walls[1].velocity = {-0.5, 0.0, 0.0};
         if ((b & 12) == 8) continue;  // moving walls without walls: not a scene
         if (!(b & 16)) s.grid->radius_min = s.grid->radius_max;
-        Case c(s);
-        const ModelFeatures need = features_of(c.scene, c.state);
+        Problem c(s);
+        const ModelFeatures need = features_of(c.scene(), c.state());
         for (const auto& name : variant_names()) {
-            VariantRun run(name, c.setup);
+            VariantRun run(name, c.setup());
             EXPECT_TRUE(run.variant->model().covers(need)) << name << " needs " << need.name() << ", runs " << run.variant->model().name();
         }
     }
@@ -247,7 +247,7 @@ TEST_P(Specialised, FrictionlessRunWithoutRotationMatchesTheRotatingKernelWithMu
 {
     Scene s = small_bed();
     s.material.mu = 0.0;  // γ_t stays 60: the friction kernel computes u_t and min(0, γ_t·m*·|u_t|) = 0
-    const Case c = settled_bed(s, false, false);
+    const Problem c = settled_bed(s, false, false);
     const Outcome o = specialised_vs_general(GetParam(), c, features(true, true, false, false, false, false), 1500);
     EXPECT_FALSE(o.specialised.rotation || o.specialised.friction) << o.specialised.name();
     EXPECT_TRUE(o.general.rotation && o.general.friction) << o.general.name();
@@ -260,7 +260,7 @@ TEST_P(Specialised, UndampedRunMatchesTheDampingKernelWithGammaZero)
 {
     Scene s = small_bed();
     s.material.gamma_n = 0.0;
-    const Case c = settled_bed(s, false, true);
+    const Problem c = settled_bed(s, false, true);
     const Outcome o = specialised_vs_general(GetParam(), c, features(false, false, true, false, false, false), 1500);
     EXPECT_FALSE(o.specialised.damping);
     EXPECT_TRUE(o.general.damping);
@@ -270,7 +270,7 @@ TEST_P(Specialised, UndampedRunMatchesTheDampingKernelWithGammaZero)
 
 TEST_P(Specialised, MonodisperseRunMatchesThePolydisperseKernel)
 {
-    const Case c = settled_bed(small_bed(), true, true);
+    const Problem c = settled_bed(small_bed(), true, true);
     const Outcome o = specialised_vs_general(GetParam(), c, features(false, false, false, false, false, true), 1500);
     EXPECT_FALSE(o.specialised.polydisperse);
     EXPECT_TRUE(o.general.polydisperse);
@@ -283,7 +283,7 @@ TEST_P(Specialised, RunWithoutWallsMatchesTheWallKernel)
 {
     Scene s = small_bed();
     s.walls.clear();  // the bed falls freely, its contacts kept
-    const Case c = settled_bed(s, false, true);
+    const Problem c = settled_bed(s, false, true);
     const Outcome o = specialised_vs_general(GetParam(), c, features(false, false, false, true, true, false), 1500);
     EXPECT_FALSE(o.specialised.walls);
     EXPECT_TRUE(o.general.walls && o.general.moving_walls);
@@ -293,7 +293,7 @@ TEST_P(Specialised, RunWithoutWallsMatchesTheWallKernel)
 
 TEST_P(Specialised, FixedWallsMatchTheMovingWallKernelAtZeroVelocity)
 {
-    const Case c = settled_bed(small_bed(), false, true);
+    const Problem c = settled_bed(small_bed(), false, true);
     const Outcome o = specialised_vs_general(GetParam(), c, features(false, false, false, false, true, false), 1500);
     EXPECT_FALSE(o.specialised.moving_walls);
     EXPECT_TRUE(o.general.moving_walls);
@@ -307,7 +307,7 @@ TEST_P(Specialised, TheComparisonSeesADampingTermThatIsNotInert)
     // report a difference, so the tests above could fail.
     Scene s = small_bed();
     s.material.gamma_n = 0.0;
-    const Case c = settled_bed(s, false, true);
+    const Problem c = settled_bed(s, false, true);
     const Outcome o = specialised_vs_general(GetParam(), c, features(false, false, true, false, false, false), 50, 60.0);
     EXPECT_NE(o.difference, "");
 }
@@ -319,7 +319,7 @@ TEST_P(Specialised, NormalOnlyRunMatchesTheFullKernel)
     s.material.mu = 0.0;
     s.material.gamma_n = 0.0;
     s.walls.clear();
-    const Case c = settled_bed(s, true, false);
+    const Problem c = settled_bed(s, true, false);
     const Outcome o = specialised_vs_general(GetParam(), c, ModelFeatures::full(), 1500);
     EXPECT_EQ(o.specialised.name(), "normal");
     EXPECT_EQ(o.general, ModelFeatures::full());
@@ -331,8 +331,8 @@ TEST_P(Specialised, ASceneWithEveryFeatureRunsTheFullModel)
 {
     Scene s = small_bed();
     s.walls[1].velocity = {-0.5, 0.0, 0.0};
-    Case c(s);
-    VariantRun run(GetParam(), c.setup);
+    Problem c(s);
+    VariantRun run(GetParam(), c.setup());
     EXPECT_EQ(run.variant->model(), ModelFeatures::full());
 }
 

@@ -181,14 +181,14 @@ Block make_start(const Scene& scene, std::int64_t settle)
 {
     Scene still = scene;
     for (Wall& w : still.walls) w.velocity = {};
-    Case c(still);
-    VariantRun run("arrays", c.setup);
+    Problem c(still);
+    VariantRun run("arrays", c.setup());
     run.driver->run(settle);
     const Snapshot s = run.snapshot();
     Block b{"start", {}};
-    for (std::size_t i = 0; i < c.state.size(); ++i) {
+    for (std::size_t i = 0; i < c.state().size(); ++i) {
         const Vec3d &x = s.position[i], &v = s.velocity[i], &w = s.angular_velocity[i];
-        b.lines.push_back(fmt::format("{} {} {} {} {} {} {} {} {} {}", hex(c.state.radius[i]), hex(x.x), hex(x.y), hex(x.z), hex(v.x),
+        b.lines.push_back(fmt::format("{} {} {} {} {} {} {} {} {} {}", hex(c.state().radius[i]), hex(x.x), hex(x.y), hex(x.z), hex(v.x),
                                       hex(v.y), hex(v.z), hex(w.x), hex(w.y), hex(w.z)));
     }
     return b;

@@ -15,8 +15,8 @@ TEST_P(Guards, UnstableTimeStepStopsWithStepAndParticle)
 {
     Scene s = dense_bed_scene(500);
     s.dt = 6e-4;  // 0.6 of the Rayleigh time: the Gear scheme blows up within 100 steps
-    Case c(s);
-    VariantRun run(GetParam(), c.setup);
+    Problem c(s);
+    VariantRun run(GetParam(), c.setup());
     try {
         run.driver->run(5000);
         ADD_FAILURE() << "an unstable run went on to the end";
@@ -33,8 +33,8 @@ TEST_P(Guards, UnstableTimeStepStopsWithStepAndParticle)
 
 TEST_P(Guards, StableRunPassesTheHealthChecks)
 {
-    Case c(dense_bed_scene(500));
-    VariantRun run(GetParam(), c.setup);
+    Problem c(dense_bed_scene(500));
+    VariantRun run(GetParam(), c.setup());
     EXPECT_NO_THROW(run.driver->run(2000));
 }
 
@@ -54,8 +54,8 @@ TEST(Capacity, ArraysOverflowNamesTheCapacityAndTheValueThatFits)
         st.radius[i] = 0.004;
         st.trans.x[i] = at[i];
     }
-    Case c(s, st);
-    VariantRun run("arrays", c.setup);
+    Problem c(s, st);
+    VariantRun run("arrays", c.setup());
     try {
         run.driver->step();
         ADD_FAILURE() << "capacity 1 did not overflow";

@@ -112,8 +112,8 @@ Impact head_on(IntegratorChoice choice, double dt)
     Scene s = head_on_scene(1.0);
     s.dt = dt;
     s.integrator = choice;
-    Case c(s);
-    VariantRun run("arrays", c.setup);
+    Problem c(s);
+    VariantRun run("arrays", c.setup());
     Impact out;
     const auto steps = std::int64_t(std::ceil(4e-3 / dt));
     for (std::int64_t k = 0; k < steps; ++k) {
@@ -135,8 +135,8 @@ TEST(Integrators, ArraysRunsEveryChoiceOnAHertzImpact)
     // rebounds elastically to 1e-3; float stays within 2e-4 of double (float's 6e-8 grown over
     // 2000 steps of a stiff contact; measured 1e-6 … 3e-5).
     Scene s = head_on_scene(1.0);
-    Case c(s);
-    const double mstar = c.setup.mass[0] / 2.0, rstar = 0.002, estar = c.setup.contact.estar_pp();
+    Problem c(s);
+    const double mstar = c.setup().mass[0] / 2.0, rstar = 0.002, estar = c.setup().contact.estar_pp();
     const double hmax = std::pow(15.0 * mstar / (16.0 * estar * std::sqrt(rstar)), 0.4);
     for (Integrator scheme : all_integrators) {
         const Impact d = head_on({scheme, Precision::float64}, 2e-6);
@@ -161,12 +161,12 @@ TEST(Integrators, AVariantWithoutTheChoiceRefusesIt)
 {
     Scene s = head_on_scene(1.0);
     s.integrator = {Integrator::verlet, Precision::float64};
-    Case c(s);
+    Problem c(s);
     for (const std::string& v : variant_names()) {
         auto variant = registry().find(v).create();
         if (variant->supports(s.integrator)) continue;
         try {
-            Driver d(*variant, c.setup);
+            Driver d(*variant, c.setup());
             ADD_FAILURE() << v << " accepted an integrator it does not support";
         } catch (const Error& e) {
             EXPECT_NE(std::string(e.what()).find("gear5 in double only, not verlet in double"), std::string::npos) << e.what();

@@ -18,9 +18,9 @@ double estar_pp(const Scene& s) { return s.contact_params().estar_pp(); }
 TEST_P(Physics, HeadOnHertzMatchesAnalyticOverlapAndContactTime)
 {
     const double v = 1.0, r = 0.004;
-    Case c(head_on_scene(v, r));
-    VariantRun run(GetParam(), c.setup);
-    const double m = c.setup.mass[0], mstar = m / 2, rstar = r / 2, es = estar_pp(c.scene);
+    Problem c(head_on_scene(v, r));
+    VariantRun run(GetParam(), c.setup());
+    const double m = c.setup().mass[0], mstar = m / 2, rstar = r / 2, es = estar_pp(c.scene());
     const double hmax_exact = std::pow(15.0 * mstar * v * v / (16.0 * es * std::sqrt(rstar)), 0.4);
     const double tc_exact = 2.87 * std::pow(mstar * mstar / (rstar * es * es * v), 0.2);
     double hmax = 0.0;
@@ -37,7 +37,7 @@ TEST_P(Physics, HeadOnHertzMatchesAnalyticOverlapAndContactTime)
         }
     }
     ASSERT_GT(first, 0);
-    const double tc = double(last - first + 1) * c.scene.dt;
+    const double tc = double(last - first + 1) * c.scene().dt;
     EXPECT_NEAR(hmax / hmax_exact, 1.0, 2e-3) << "h_max " << hmax << " against " << hmax_exact;
     // 2.87 is the rounded constant of the analytic contact time (2.868); the step resolves t_c to 1/200.
     EXPECT_NEAR(tc / tc_exact, 1.0, 1e-2) << "t_c " << tc << " against " << tc_exact;
@@ -49,17 +49,17 @@ TEST_P(Physics, HeadOnHertzMatchesAnalyticOverlapAndContactTime)
 TEST_P(Physics, EnergyIsConservedWithoutDampingOrFriction)
 {
     const double v = 1.0, r = 0.004;
-    Case c(head_on_scene(v, r));
-    VariantRun run(GetParam(), c.setup);
-    const double es = estar_pp(c.scene), rstar = r / 2;
-    const double e0 = kinetic_energy(run.snapshot(), c.setup);
+    Problem c(head_on_scene(v, r));
+    VariantRun run(GetParam(), c.setup());
+    const double es = estar_pp(c.scene()), rstar = r / 2;
+    const double e0 = kinetic_energy(run.snapshot(), c.setup());
     double worst = 0.0;
     for (std::int64_t k = 1; k <= 1500; ++k) {
         run.driver->step();
         const Snapshot s = run.snapshot();
         const Vec3d d = s.position[1] - s.position[0];
         const double h = std::max(0.0, 2 * r - std::sqrt(dot(d, d)));
-        const double e = kinetic_energy(s, c.setup) + 8.0 / 15.0 * es * std::sqrt(rstar) * std::pow(h, 2.5);
+        const double e = kinetic_energy(s, c.setup()) + 8.0 / 15.0 * es * std::sqrt(rstar) * std::pow(h, 2.5);
         worst = std::max(worst, std::abs(e - e0) / e0);
     }
     EXPECT_LT(worst, 1e-4);
@@ -68,12 +68,12 @@ TEST_P(Physics, EnergyIsConservedWithoutDampingOrFriction)
 TEST_P(Physics, SphereSettlesOnAWallAtTheAnalyticOverlap)
 {
     const double r = 0.004;
-    Case c(drop_scene(0.001, r));
-    VariantRun run(GetParam(), c.setup);
+    Problem c(drop_scene(0.001, r));
+    VariantRun run(GetParam(), c.setup());
     run.driver->run(120000);  // 1.2 s: the bounce decays as exp(-γn·t/2), to 1e-15 of its amplitude
     const Snapshot s = run.snapshot();
-    const double m = c.setup.mass[0];
-    const double es = c.scene.contact_params().estar_pw();
+    const double m = c.setup().mass[0];
+    const double es = c.scene().contact_params().estar_pw();
     const double h_exact = std::pow(3.0 * m * 10.0 / (4.0 * es * std::sqrt(r)), 2.0 / 3.0);
     EXPECT_NEAR((r - s.position[0].z) / h_exact, 1.0, 1e-6);
     EXPECT_LT(std::abs(s.velocity[0].z), 1e-9);
@@ -83,10 +83,10 @@ TEST_P(Physics, FreeFallFollowsTheParabola)
 {
     Scene sc = drop_scene(0.05, 0.004);
     sc.walls.clear();
-    Case c(sc);
-    VariantRun run(GetParam(), c.setup);
+    Problem c(sc);
+    VariantRun run(GetParam(), c.setup());
     run.driver->run(1000);
-    const double t = 1000 * c.scene.dt;
+    const double t = 1000 * c.scene().dt;
     EXPECT_NEAR(run.snapshot().position[0].z, 0.054 - 5.0 * t * t, 1e-14);
 }
 
@@ -98,15 +98,15 @@ TEST_P(Physics, ParticleContactsConserveMomentum)
     sc.gravity = {0, 0, 0};
     sc.walls.clear();
     sc.grid->spacing = 2.02 * sc.grid->radius_max;  // close enough for many collisions
-    Case c(sc);
-    VariantRun run(GetParam(), c.setup);
+    Problem c(sc);
+    VariantRun run(GetParam(), c.setup());
     auto momentum = [&](const Snapshot& s) {
         Vec3d p{};
-        for (std::size_t i = 0; i < s.velocity.size(); ++i) p += c.setup.mass[i] * s.velocity[i];
+        for (std::size_t i = 0; i < s.velocity.size(); ++i) p += c.setup().mass[i] * s.velocity[i];
         return p;
     };
     double scale = 0.0;
-    for (std::size_t i = 0; i < c.state.size(); ++i) scale += c.setup.mass[i] * std::sqrt(dot(c.state.trans.v[i], c.state.trans.v[i]));
+    for (std::size_t i = 0; i < c.state().size(); ++i) scale += c.setup().mass[i] * std::sqrt(dot(c.state().trans.v[i], c.state().trans.v[i]));
     const Vec3d p0 = momentum(run.snapshot());
     run.driver->run(3000);
     EXPECT_GT(run.variant->counts().particle_particle, 0);

@@ -48,10 +48,10 @@ std::vector<std::string> fields(const std::string& line)
 TEST(RunLog, FreeFallIsExactAndTheUndampedBounceConservesTotalEnergy)
 {
     const double gap = 0.001, r = 0.004;
-    Case c(undamped_drop(gap, r));
-    VariantRun run("arrays", c.setup);
-    const double m = c.setup.mass[0], g = c.scene.gravity.z, z0 = c.state.trans.x[0].z;
-    const LogRow first = measure_log_row(run.snapshot(), c.setup);
+    Problem c(undamped_drop(gap, r));
+    VariantRun run("arrays", c.setup());
+    const double m = c.setup().mass[0], g = c.scene().gravity.z, z0 = c.state().trans.x[0].z;
+    const LogRow first = measure_log_row(run.snapshot(), c.setup());
     ASSERT_EQ(first.wall_force.size(), 1u);
     EXPECT_DOUBLE_EQ(first.gravitational, -m * g * z0);
     EXPECT_EQ(first.kinetic_translational, 0.0);
@@ -61,7 +61,7 @@ TEST(RunLog, FreeFallIsExactAndTheUndampedBounceConservesTotalEnergy)
     bool touched = false;
     for (std::int64_t k = 1; k <= 4000; ++k) {
         run.driver->step();
-        const LogRow row = measure_log_row(run.snapshot(), c.setup);
+        const LogRow row = measure_log_row(run.snapshot(), c.setup());
         EXPECT_EQ(row.total(), row.kinetic_translational + row.kinetic_rotational + row.gravitational + row.elastic);
         worst = std::max(worst, std::abs(row.total() - e0) / scale);
         elastic_max = std::max(elastic_max, row.elastic);
@@ -96,13 +96,13 @@ TEST(RunLog, FreeFallIsExactAndTheUndampedBounceConservesTotalEnergy)
 TEST(RunLog, ASphereAtRestPushesTheFloorWithItsWeightAndStoresTheHertzEnergy)
 {
     const double r = 0.004;
-    Case c(drop_scene(0.001, r));
-    VariantRun run("arrays", c.setup);
+    Problem c(drop_scene(0.001, r));
+    VariantRun run("arrays", c.setup());
     run.driver->run(120000);  // 1.2 s: the bounce decays as exp(-γn·t/2), to 1e-15 of its amplitude
-    const LogRow row = measure_log_row(run.snapshot(), c.setup);
-    const double m = c.setup.mass[0];
-    const Vec3d g = c.scene.gravity;
-    const double es = c.setup.contact.hertz_pw * 3.0 / 4.0;
+    const LogRow row = measure_log_row(run.snapshot(), c.setup());
+    const double m = c.setup().mass[0];
+    const Vec3d g = c.scene().gravity;
+    const double es = c.setup().contact.hertz_pw * 3.0 / 4.0;
     const double h = std::pow(3.0 * m * std::sqrt(dot(g, g)) / (4.0 * es * std::sqrt(r)), 2.0 / 3.0);  // physics.md §8
     EXPECT_EQ(row.contacts_wall, 1);
     EXPECT_EQ(row.contacts_particle, 0);
@@ -122,29 +122,29 @@ TEST(RunLog, PairContactsCountAndTheirReactionsBalanceTheWeightOnTheFloor)
     const double r = 0.004;
     Scene s = drop_scene(0.0001, r);
     s.particles.push_back({r, {0.0, 0.0, 3.0 * r + 0.0003}, {}, {}});
-    Case c(s);
-    VariantRun run("arrays", c.setup);
+    Problem c(s);
+    VariantRun run("arrays", c.setup());
     run.driver->run(300000);
-    const LogRow row = measure_log_row(run.snapshot(), c.setup);
-    const double m = c.setup.mass[0];
+    const LogRow row = measure_log_row(run.snapshot(), c.setup());
+    const double m = c.setup().mass[0];
     EXPECT_EQ(row.contacts_particle, 1);
     EXPECT_EQ(row.contacts_wall, 1);
     EXPECT_NEAR(row.wall_force[0].z / (2.0 * m * s.gravity.z), 1.0, 1e-6);
     // The pair holds one weight with R* = r/2 and E*_pp; the wall holds two with R* = r and E*_pw.
-    const double epp = c.setup.contact.hertz_pp * 0.75;
+    const double epp = c.setup().contact.hertz_pp * 0.75;
     const double h_pair = std::pow(3.0 * m * 10.0 / (4.0 * epp * std::sqrt(r / 2)), 2.0 / 3.0);
-    const double h_wall = std::pow(3.0 * 2.0 * m * 10.0 / (4.0 * c.setup.contact.estar_pw() * std::sqrt(r)), 2.0 / 3.0);
+    const double h_wall = std::pow(3.0 * 2.0 * m * 10.0 / (4.0 * c.setup().contact.estar_pw() * std::sqrt(r)), 2.0 / 3.0);
     EXPECT_NEAR(row.largest_overlap_ratio, std::max(h_pair, h_wall) / r, 1e-5 * std::max(h_pair, h_wall) / r);
 }
 
 TEST(RunLog, ABlownUpStateGivesNaNNotACrash)
 {
     // 125 grains: the contact set is a cell list, which cannot place a non-finite position.
-    Case c(dense_bed_scene(125));
-    VariantRun run("arrays", c.setup);
+    Problem c(dense_bed_scene(125));
+    VariantRun run("arrays", c.setup());
     Snapshot s = run.snapshot();
     s.position[7].z = std::nan("");
-    const LogRow row = measure_log_row(s, c.setup);
+    const LogRow row = measure_log_row(s, c.setup());
     EXPECT_TRUE(std::isnan(row.elastic));
     EXPECT_TRUE(std::isnan(row.total()));
     EXPECT_TRUE(std::isnan(row.largest_overlap_ratio));
@@ -155,21 +155,21 @@ TEST(RunLog, ABlownUpStateGivesNaNNotACrash)
 
 TEST(RunLog, TheFileHasAHeaderAndARowPerLoggedStep)
 {
-    Case c(undamped_drop(0.001, 0.004));
-    VariantRun run("arrays", c.setup);
+    Problem c(undamped_drop(0.001, 0.004));
+    VariantRun run("arrays", c.setup());
     const std::filesystem::path file = "run_log_test.csv";
     const std::int64_t steps = 250, every = 100;
     std::vector<LogRow> expected;
     {
-        RunLog log(file, c.setup, every);
+        RunLog log(file, c.setup(), every);
         Snapshot s = run.snapshot();
         log.write(s);
-        expected.push_back(measure_log_row(s, c.setup));
+        expected.push_back(measure_log_row(s, c.setup()));
         run.driver->run(steps, [&](std::int64_t k) {
             if (!log.due(k, steps)) return;
             run.variant->snapshot(s);
             log.write(s);
-            expected.push_back(measure_log_row(s, c.setup));
+            expected.push_back(measure_log_row(s, c.setup()));
         });
         // Each row is in the file as soon as it is written, before the log is closed.
         EXPECT_EQ(read_lines(file).size(), 5u);
@@ -190,7 +190,7 @@ TEST(RunLog, TheFileHasAHeaderAndARowPerLoggedStep)
         EXPECT_EQ(std::stod(f[4]), expected[i - 1].gravitational);
         EXPECT_EQ(std::stod(f[6]), expected[i - 1].total());
     }
-    EXPECT_THROW(RunLog(file, c.setup, 0), Error);
+    EXPECT_THROW(RunLog(file, c.setup(), 0), Error);
     std::filesystem::remove(file);
 }
 

@@ -24,7 +24,7 @@ struct Packing {
 
 // A random packing in a box, dense enough that most particles overlap some others; at rest with zero
 // Gear derivatives, so the predictor leaves positions unchanged and forces are those of these positions.
-Case packing(const Packing& p, std::int64_t n, std::uint64_t seed)
+Problem packing(const Packing& p, std::int64_t n, std::uint64_t seed)
 {
     Scene s;
     s.name = p.name;
@@ -55,7 +55,7 @@ Case packing(const Packing& p, std::int64_t n, std::uint64_t seed)
     }
     st.walls = s.walls;
     st.dt = s.dt;
-    return Case(s, st);
+    return Problem(s, st);
 }
 
 double max_abs(const std::vector<Vec3d>& a)
@@ -90,17 +90,17 @@ TEST_P(Search, FindsExactlyTheBruteForceContactSet)
     const auto& [variant, k] = GetParam();
     const Packing& p = kPackings[k];
     for (std::uint64_t seed : {1u, 2u, 3u}) {
-        Case c = packing(p, 1200, seed);
-        VariantRun run(variant, c.setup);
+        Problem c = packing(p, 1200, seed);
+        VariantRun run(variant, c.setup());
         run.driver->step();
         const Snapshot s = run.snapshot();
         // The reference at the predicted positions and velocities, which are the initial ones because
         // every derivative is zero; the moving wall is at its step-1 position.
         std::vector<Vec3d> f, t;
-        reference_forces(c.state.trans.x, c.state.trans.v, c.state.rot.v, c.state.radius, c.setup.mass, c.state.walls, 1, c.scene.dt,
-                         c.setup.contact, f, t);
-        const auto pairs = contact_pairs(c.state.trans.x, c.state.radius, true);
-        ASSERT_GT(pairs.size(), c.state.size());  // dense: more contacts than particles
+        reference_forces(c.state().trans.x, c.state().trans.v, c.state().rot.v, c.state().radius, c.setup().mass, c.state().walls, 1, c.scene().dt,
+                         c.setup().contact, f, t);
+        const auto pairs = contact_pairs(c.state().trans.x, c.state().radius, true);
+        ASSERT_GT(pairs.size(), c.state().size());  // dense: more contacts than particles
         EXPECT_EQ(run.variant->counts().particle_particle, std::int64_t(pairs.size())) << p.name << " seed " << seed;
         Snapshot ref = s;
         ref.force = f;

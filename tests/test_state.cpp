@@ -22,7 +22,7 @@ fs::path temp_dir()
 }
 
 // Runs `a` steps, saves to a file, writes a scene that starts from it, and returns the continued case.
-Case continue_from_file(const Scene& scene, const Variant& v, const State& initial, const fs::path& file)
+Problem continue_from_file(const Scene& scene, const Variant& v, const State& initial, const fs::path& file)
 {
     State st;
     v.save(st);
@@ -33,7 +33,7 @@ Case continue_from_file(const Scene& scene, const Variant& v, const State& initi
     next.grid.reset();
     next.particles.clear();
     next.state_file = file;
-    return Case(next);
+    return Problem(next);
 }
 } // namespace
 
@@ -45,14 +45,14 @@ TEST_P(SaveContinue, ContinuedRunIsBitIdenticalToUninterruptedRun)
     for (bool moving : {false, true}) {
         Scene s = dense_bed_scene(500, 3);
         if (moving) s.walls[1].velocity = {-0.5, 0.0, 0.0};
-        Case c(s);
-        VariantRun whole(GetParam(), c.setup);
+        Problem c(s);
+        VariantRun whole(GetParam(), c.setup());
         whole.driver->run(800);
-        VariantRun first(GetParam(), c.setup);
+        VariantRun first(GetParam(), c.setup());
         first.driver->run(400);
-        Case cont = continue_from_file(s, *first.variant, c.state, dir / "half.state");
-        EXPECT_EQ(cont.state.step, 400);
-        VariantRun second(GetParam(), cont.setup);
+        Problem cont = continue_from_file(s, *first.variant, c.state(), dir / "half.state");
+        EXPECT_EQ(cont.state().step, 400);
+        VariantRun second(GetParam(), cont.setup());
         second.driver->run(400);
         if (registry().find(GetParam()).bitwise) {
             const auto d = first_difference(whole.snapshot(), second.snapshot());
@@ -78,8 +78,8 @@ INSTANTIATE_TEST_SUITE_P(AllVariants, SaveContinue, ::testing::ValuesIn(variant_
 TEST(StateFile, RoundTripsEveryBitAndRejectsDamage)
 {
     const fs::path dir = temp_dir();
-    Case c(dense_bed_scene(200));
-    State s = c.state;
+    Problem c(dense_bed_scene(200));
+    State s = c.state();
     s.trans.b5[3].y = 1.234567890123e-300;
     s.walls[1].velocity = {-0.5, 0, 0};
     s.walls[1].ref_step = 42;
@@ -117,8 +117,8 @@ TEST(StateFile, RoundTripsEveryBitAndRejectsDamage)
 TEST(StateFile, RefusesAStateFromAnotherScene)
 {
     const fs::path dir = temp_dir();
-    Case c(dense_bed_scene(200));
-    save_state(c.state, dir / "b.state");
+    Problem c(dense_bed_scene(200));
+    save_state(c.state(), dir / "b.state");
     Scene other = dense_bed_scene(200);
     other.grid.reset();
     other.state_file = dir / "b.state";
