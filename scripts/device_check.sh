@@ -15,22 +15,33 @@
 # collapsed by then), SIZES (default "10000 100000 1000000"), BIG (default 10000000; 0 skips it),
 # CMP_N and CMP_STEPS (the comparisons' bed and length, default 2000 and 1000), RESULTS (default
 # results/gpu). VARIANT=cuda_host runs the whole flow on the CPU, to try the script without a GPU.
-set -uo pipefail
-cd "$(dirname "$0")/.."
+# Usage: scripts/device_check.sh [--pack] [--build-dir DIR]
+#   --pack           on the build machine: build DIR and pack DIR/dist for the GPU machine
+#   --build-dir DIR  the portable build folder (default build-gpu); its dist/ is what travels
+source "$(dirname "$0")/lib.sh"
+BUILD_DIR=${DEMMAT_BUILD_DIR:-build-gpu}
+pack=false
+while [[ $# -gt 0 ]]; do
+  case "$1" in
+    --pack) pack=true; shift ;;
+    *) shared_option "$@"; shift "$SHIFT" ;;
+  esac
+done
+set +e  # on the GPU machine a failed stage is logged and the next one runs
 
-dist=build-gpu/dist
+dist=$BUILD_DIR/dist
 
-if [[ "${1:-}" == "--pack" ]]; then
+if $pack; then
   set -e
   # Portable code for an unknown host CPU: fast without -march=native (bit-identical either way).
-  cmake -S . -B build-gpu -DCMAKE_BUILD_TYPE=Release -DDEMMAT_FAST_NATIVE=OFF -DDEMMAT_BUILD_BENCH=OFF \
+  cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DDEMMAT_FAST_NATIVE=OFF -DDEMMAT_BUILD_BENCH=OFF \
         -DCMAKE_EXE_LINKER_FLAGS="-static-libstdc++ -static-libgcc" ${CCACHE_DIR:+-DCMAKE_CXX_COMPILER_LAUNCHER=ccache} >/dev/null
-  cmake --build build-gpu -j"${JOBS:-2}" --target demmat
+  cmake --build "$BUILD_DIR" -j"${JOBS:-2}" --target demmat
   rm -rf "$dist" && mkdir -p "$dist/bin" "$dist/lib" "$dist/glibc"
-  cp build-gpu/app/demmat "$dist/bin/"
+  cp "$BUILD_DIR/app/demmat" "$dist/bin/"
   # Every shared library it needs beside it; the C library apart, in glibc/, used (through its own
   # loader) only where the GPU machine's glibc is older than the one the binary was linked against.
-  ldd build-gpu/app/demmat | awk '/=> \//{print $3} /ld-linux/{print $1}' | while read -r lib; do
+  ldd "$BUILD_DIR/app/demmat" | awk '/=> \//{print $3} /ld-linux/{print $1}' | while read -r lib; do
     case "$(basename "$lib")" in
       libcuda.so*) ;;
       libc.so*|libm.so*|libdl.so*|libpthread.so*|librt.so*|ld-linux*) cp -L "$lib" "$dist/glibc/" ;;
@@ -41,17 +52,18 @@ if [[ "${1:-}" == "--pack" ]]; then
   { echo "built on: $(uname -srm); $(ldd --version | head -1)"
     echo "highest glibc symbol version needed:"
     for f in "$dist"/bin/* "$dist"/lib/*; do objdump -T "$f" 2>/dev/null; done | grep -o 'GLIBC_[0-9.]*' | sort -Vu | tail -1
-    grep -h 'set(CMAKE_CUDA_COMPILER_VERSION' build-gpu/CMakeFiles/*/CMakeCUDACompiler.cmake 2>/dev/null | head -1
-    grep -h '^CUDA_FLAGS' build-gpu/variants/CMakeFiles/demmat_variant_cuda.dir/flags.make || echo "no cuda variant in this build"
+    grep -h 'set(CMAKE_CUDA_COMPILER_VERSION' $BUILD_DIR/CMakeFiles/*/CMakeCUDACompiler.cmake 2>/dev/null | head -1
+    grep -h '^CUDA_FLAGS' $BUILD_DIR/variants/CMakeFiles/demmat_variant_cuda.dir/flags.make || echo "no cuda variant in this build"
   } > "$dist/build-info.txt"
   # The device code's arithmetic, checked here (cuobjdump is not on this machine): the PTX of cuda.cu
   # with the build's flags has no fused multiply-add, and every f64 add, mul, div and sqrt rounds to nearest.
-  nvcc="$(sed -n 's/^set(CMAKE_CUDA_COMPILER "\(.*\)")$/\1/p' build-gpu/CMakeFiles/*/CMakeCUDACompiler.cmake | head -1)"
+  nvcc="$(sed -n 's/^set(CMAKE_CUDA_COMPILER "\(.*\)")$/\1/p' $BUILD_DIR/CMakeFiles/*/CMakeCUDACompiler.cmake | head -1)"
   if [[ -n "$nvcc" ]]; then
-    flags="$(grep -h '^CUDA_FLAGS' build-gpu/variants/CMakeFiles/demmat_variant_cuda.dir/flags.make | cut -d= -f2- | sed 's/--generate-code=[^ ]*//g')"
-    incs="$(grep -h '^CUDA_INCLUDES' build-gpu/variants/CMakeFiles/demmat_variant_cuda.dir/flags.make | cut -d= -f2-)"
+    flags="$(grep -h '^CUDA_FLAGS' $BUILD_DIR/variants/CMakeFiles/demmat_variant_cuda.dir/flags.make | cut -d= -f2- | sed 's/--generate-code=[^ ]*//g')"
+    incs="$(grep -h '^CUDA_INCLUDES' $BUILD_DIR/variants/CMakeFiles/demmat_variant_cuda.dir/flags.make | cut -d= -f2-)"
     # shellcheck disable=SC2086
-    (cd build-gpu/variants && "$nvcc" $incs $flags -arch=compute_90 --ptx "$OLDPWD/variants/cuda/cuda.cu" -o "$OLDPWD/$dist/cuda.ptx")
+    root=$PWD; dist_abs=$(realpath -m "$dist")
+    (cd "$BUILD_DIR/variants" && "$nvcc" $incs $flags -arch=compute_90 --ptx "$root/variants/cuda/cuda.cu" -o "$dist_abs/cuda.ptx")
     { echo "PTX of variants/cuda/cuda.cu (compute_90):"
       echo "  kernels (entry points): $(grep -c '\.entry' "$dist/cuda.ptx")"
       echo "  fma instructions: $(grep -cE '^\s*fma\.' "$dist/cuda.ptx")"
