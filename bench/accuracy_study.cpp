@@ -22,6 +22,7 @@
 #include "demmat/reference.hpp"
 #include "demmat/registry.hpp"
 #include "demmat/scenes.hpp"
+#include "demmat/stability.hpp"
 
 using namespace demmat;
 using json = nlohmann::json;
@@ -247,7 +248,7 @@ struct TwoBodyCase {
 double hertz_tc(double mstar, double rstar, double estar, double v)
 {
     // Exact Hertz contact time: 2·(h_max/v)·∫₀¹(1 − x^{5/2})^{−1/2} dx, the integral (2/5)·B(2/5, 1/2).
-    const double hmax = std::pow(15.0 * mstar * v * v / (16.0 * estar * std::sqrt(rstar)), 0.4);
+    const double hmax = hertz_max_overlap(mstar, rstar, estar, v);
     const double integral = 0.4 * std::tgamma(0.4) * std::tgamma(0.5) / std::tgamma(0.9);
     return 2.0 * hmax / v * integral;
 }
@@ -297,7 +298,7 @@ void two_body_study(const Options& opt, std::vector<Row>& rows, json& refs)
         const bool wall = c.oblique;
         const double mstar = wall ? su.mass[0] : su.mass[0] * su.mass[1] / (su.mass[0] + su.mass[1]);
         const double rstar = wall ? r : r / 2.0;
-        const double estar = 0.75 * (wall ? su.contact.hertz_pw : su.contact.hertz_pp);
+        const double estar = wall ? su.contact.estar_pw() : su.contact.estar_pp();
         const double vn = wall ? -st.trans.v[0].z : st.trans.v[0].x - st.trans.v[1].x;
         const double tc = hertz_tc(mstar, rstar, estar, vn);
         const double gap = -c.impact.normal({0.0, st.trans.x, st.trans.v, st.rot.v}).h;
@@ -315,7 +316,7 @@ void two_body_study(const Options& opt, std::vector<Row>& rows, json& refs)
         ImpactMeasures target = ref;
         if (c.name == "head_on_elastic") {
             // Analytic Hertz (physics.md §8): these are the targets; the RK4 values are kept to show it agrees.
-            target.max_overlap = std::pow(15.0 * mstar * vn * vn / (16.0 * estar * std::sqrt(rstar)), 0.4);
+            target.max_overlap = hertz_max_overlap(mstar, rstar, estar, vn);
             target.contact_time = tc;
             target.restitution = 1.0;
             jr["analytic"] = {{"contact_time", target.contact_time}, {"max_overlap", target.max_overlap}, {"restitution", 1.0}};

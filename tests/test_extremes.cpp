@@ -222,7 +222,7 @@ TEST_P(Extremes, SmallGrainRestsOnABigOneAtTheAnalyticOverlaps)
     VariantRun run(GetParam(), c.setup);
     EXPECT_EQ(run_error(run, 10000), "");
     const Snapshot sn = run.snapshot();
-    const double mb = c.setup.mass[0], ms = c.setup.mass[1], es = 0.75 * c.setup.contact.hertz_pp;
+    const double mb = c.setup.mass[0], ms = c.setup.mass[1], es = c.setup.contact.estar_pp();
     const double hw = std::pow(3.0 * (mb + ms) * 10.0 / (4.0 * es * std::sqrt(R)), 2.0 / 3.0);
     const double hp = std::pow(3.0 * ms * 10.0 / (4.0 * es * std::sqrt(R * r / (R + r))), 2.0 / 3.0);
     EXPECT_NEAR((R - sn.position[0].z) / hw, 1.0, 1e-5);
@@ -287,7 +287,7 @@ TEST_P(Extremes, OverdampedContactGainsNoEnergyAndDoesNotStick)
     s.checks.interval = 1;
     Case c(s);
     VariantRun run(GetParam(), c.setup);
-    const double es = 0.75 * c.setup.contact.hertz_pp;
+    const double es = c.setup.contact.estar_pp();
     double last = INFINITY, hmax = 0.0, prev_h = -1.0;
     bool past_max = false;
     for (int k = 0; k < 5000; ++k) {
@@ -361,7 +361,7 @@ TEST_P(Extremes, EnergyGrowthIsDetected)
     const double v = 1.0, r = 0.004;
     Scene s = head_on_scene(v, r);
     const double m = sphere_mass(r, 1000.0);
-    s.dt = 0.22 * hertz_contact_time(m / 2, r / 2, 0.75 * s.contact_params().hertz_pp, v);
+    s.dt = 0.22 * hertz_contact_time(m / 2, r / 2, s.contact_params().estar_pp(), v);
     s.checks.interval = 1;
     Case c(s);
     VariantRun run(GetParam(), c.setup);

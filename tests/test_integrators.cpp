@@ -136,7 +136,7 @@ TEST(Integrators, ArraysRunsEveryChoiceOnAHertzImpact)
     // 2000 steps of a stiff contact; measured 1e-6 … 3e-5).
     Scene s = head_on_scene(1.0);
     Case c(s);
-    const double mstar = c.setup.mass[0] / 2.0, rstar = 0.002, estar = 0.75 * c.setup.contact.hertz_pp;
+    const double mstar = c.setup.mass[0] / 2.0, rstar = 0.002, estar = c.setup.contact.estar_pp();
     const double hmax = std::pow(15.0 * mstar / (16.0 * estar * std::sqrt(rstar)), 0.4);
     for (Integrator scheme : all_integrators) {
         const Impact d = head_on({scheme, Precision::float64}, 2e-6);

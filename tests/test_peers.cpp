@@ -169,7 +169,7 @@ TEST(PeerLammps, SphereComesToRestOnAWallAtTheSuitesOverlap)
     const Snapshot suite = run_suite(scene, steps);
     const double r = scene.particles[0].radius;
     const double m = sphere_mass(r, scene.material.density);
-    const double estar = scene.contact_params().hertz_pw * 0.75;
+    const double estar = scene.contact_params().estar_pw();
     const double h_rest = std::cbrt(std::pow(3.0 * m * 10.0 / (4.0 * estar * std::sqrt(r)), 2.0));  // physics.md §8
     const double h_lammps = r - lammps.trans.x[0].z, h_suite = r - suite.position[0].z;
     EXPECT_NEAR(h_suite, h_rest, 1e-3 * h_rest);

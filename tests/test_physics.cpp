@@ -12,7 +12,7 @@ using namespace demmat::test;
 class Physics : public ::testing::TestWithParam<std::string> {};
 
 namespace {
-double estar_pp(const Scene& s) { return s.contact_params().hertz_pp * 3.0 / 4.0; }
+double estar_pp(const Scene& s) { return s.contact_params().estar_pp(); }
 } // namespace
 
 TEST_P(Physics, HeadOnHertzMatchesAnalyticOverlapAndContactTime)
@@ -73,7 +73,7 @@ TEST_P(Physics, SphereSettlesOnAWallAtTheAnalyticOverlap)
     run.driver->run(120000);  // 1.2 s: the bounce decays as exp(-γn·t/2), to 1e-15 of its amplitude
     const Snapshot s = run.snapshot();
     const double m = c.setup.mass[0];
-    const double es = c.scene.contact_params().hertz_pw * 3.0 / 4.0;
+    const double es = c.scene.contact_params().estar_pw();
     const double h_exact = std::pow(3.0 * m * 10.0 / (4.0 * es * std::sqrt(r)), 2.0 / 3.0);
     EXPECT_NEAR((r - s.position[0].z) / h_exact, 1.0, 1e-6);
     EXPECT_LT(std::abs(s.velocity[0].z), 1e-9);

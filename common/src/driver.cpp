@@ -75,14 +75,8 @@ Driver::Driver(Variant& variant, const Setup& setup) : variant_(variant), setup_
     if (scene.checks.max_speed > 0.0) {
         speed_bound_ = scene.checks.max_speed;
     } else {
-        // Ten times the fastest speed the scene can explain: the fastest initial particle, a free fall
-        // across the domain, and the fastest wall.
-        double v0 = 0.0, vw = 0.0;
-        for (const Vec3d& v : setup.state->trans.v) v0 = std::max(v0, std::sqrt(dot(v, v)));
-        for (const Wall& w : setup.state->walls) vw = std::max(vw, std::sqrt(dot(w.velocity, w.velocity)));
-        const Vec3d ext = scene.domain.max - scene.domain.min;
-        const double fall = std::sqrt(2.0 * std::sqrt(dot(scene.gravity, scene.gravity)) * std::sqrt(dot(ext, ext)));
-        speed_bound_ = 10.0 * (v0 + fall + vw) + 1.0;
+        // Ten times the fastest speed the scene can explain (stability.hpp).
+        speed_bound_ = 10.0 * explained_speed(scene, *setup.state) + 1.0;
     }
     // Energy-growth check (docs/stability.md): the start energy and what gravity may add to it.
     const State& st = *setup.state;

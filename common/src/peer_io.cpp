@@ -84,7 +84,7 @@ std::string data_file(const Scene& scene, const State& s)
     return out;
 }
 
-double e_star_pw(const Scene& scene) { return scene.contact_params().hertz_pw * 0.75; }
+double e_star_pw(const Scene& scene) { return scene.contact_params().estar_pw(); }
 
 std::string lammps_fragment(const Scene& scene, const State& s, const PeerOptions& o, double skin)
 {
@@ -414,17 +414,7 @@ State import_peer_state(const std::filesystem::path& file, const Scene& scene)
     s.trans.x = x;
     s.trans.v = v;
     s.rot.v = w;
-    // t = 0 accelerations, as for any new scene (state.cpp initial_state).
-    std::vector<double> mass(n);
-    for (std::size_t i = 0; i < n; ++i) mass[i] = sphere_mass(s.radius[i], scene.material.density);
-    std::vector<Vec3d> f, t;
-    reference_forces(s.trans.x, s.trans.v, s.rot.v, s.radius, mass, s.walls, s.step, scene.dt, scene.contact_params(), f, t);
-    for (std::size_t i = 0; i < n; ++i) {
-        const double inertia = sphere_inertia(s.radius[i], mass[i]);
-        s.trans.a[i] = {acceleration(f[i].x, mass[i], scene.gravity.x), acceleration(f[i].y, mass[i], scene.gravity.y),
-                        acceleration(f[i].z, mass[i], scene.gravity.z)};
-        s.rot.a[i] = {t[i].x / inertia, t[i].y / inertia, t[i].z / inertia};
-    }
+    initial_accelerations(scene, s);  // t = 0, as for any new scene
     return s;
 }
 

@@ -20,15 +20,26 @@ double hertz_contact_time(double mstar, double rstar, double estar, double speed
     return 2.87 * std::pow(mstar * mstar / (rstar * estar * estar * speed), 0.2);
 }
 
-double impact_speed_bound(const Scene& scene, const State& state)
+double fastest_wall_speed(const State& state)
 {
-    double v0 = 0.0, vw = 0.0;
-    for (const Vec3d& v : state.trans.v) v0 = std::max(v0, std::sqrt(dot(v, v)));
+    double vw = 0.0;
     for (const Wall& w : state.walls) vw = std::max(vw, std::sqrt(dot(w.velocity, w.velocity)));
+    return vw;
+}
+
+double explained_speed(const Scene& scene, const State& state)
+{
+    double v0 = 0.0;
+    for (const Vec3d& v : state.trans.v) v0 = std::max(v0, std::sqrt(dot(v, v)));
     const Vec3d ext = scene.domain.max - scene.domain.min;
     const double fall = std::sqrt(2.0 * std::sqrt(dot(scene.gravity, scene.gravity)) * std::sqrt(dot(ext, ext)));
-    const double vp = v0 + fall + vw;
-    return state.size() > 1 ? 2.0 * vp : vp + vw;
+    return v0 + fall + fastest_wall_speed(state);
+}
+
+double impact_speed_bound(const Scene& scene, const State& state)
+{
+    const double vp = explained_speed(scene, state);
+    return state.size() > 1 ? 2.0 * vp : vp + fastest_wall_speed(state);
 }
 
 ContactTime shortest_contact_time(const Scene& scene, const State& state, double speed)
@@ -40,9 +51,9 @@ ContactTime shortest_contact_time(const Scene& scene, const State& state, double
     const double m = sphere_mass(rmin, scene.material.density);
     const ContactParams<double> p = scene.contact_params();
     out.tc = INFINITY;
-    if (state.size() > 1) out.tc = hertz_contact_time(m / 2.0, rmin / 2.0, 0.75 * p.hertz_pp, speed);
+    if (state.size() > 1) out.tc = hertz_contact_time(m / 2.0, rmin / 2.0, p.estar_pp(), speed);
     if (!state.walls.empty()) {
-        const double tw = hertz_contact_time(m, rmin, 0.75 * p.hertz_pw, speed);
+        const double tw = hertz_contact_time(m, rmin, p.estar_pw(), speed);
         if (tw < out.tc) {
             out.tc = tw;
             out.wall = true;

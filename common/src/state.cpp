@@ -270,6 +270,20 @@ State parse_state(const std::string& bytes, const std::string& label)
     return s;
 }
 
+void initial_accelerations(const Scene& scene, State& s)
+{
+    std::vector<double> mass(s.size());
+    for (std::size_t i = 0; i < s.size(); ++i) mass[i] = sphere_mass(s.radius[i], scene.material.density);
+    std::vector<Vec3d> f, t;
+    reference_forces(s.trans.x, s.trans.v, s.rot.v, s.radius, mass, s.walls, s.step, scene.dt, scene.contact_params(), f, t);
+    for (std::size_t i = 0; i < s.size(); ++i) {
+        const double inertia = sphere_inertia(s.radius[i], mass[i]);
+        s.trans.a[i] = {acceleration(f[i].x, mass[i], scene.gravity.x), acceleration(f[i].y, mass[i], scene.gravity.y),
+                        acceleration(f[i].z, mass[i], scene.gravity.z)};
+        s.rot.a[i] = {t[i].x / inertia, t[i].y / inertia, t[i].z / inertia};
+    }
+}
+
 State initial_state(const Scene& scene)
 {
     State s;
@@ -299,17 +313,7 @@ State initial_state(const Scene& scene)
     s.fingerprint = scene.fingerprint(s.size());
     validate_new_particles(scene, s);
 
-    // t = 0: a = F(x, v)/m + g, α = T/I; b3 = b4 = b5 = 0.
-    std::vector<double> mass(s.size());
-    for (std::size_t i = 0; i < s.size(); ++i) mass[i] = sphere_mass(s.radius[i], scene.material.density);
-    std::vector<Vec3d> f, t;
-    reference_forces(s.trans.x, s.trans.v, s.rot.v, s.radius, mass, s.walls, s.step, scene.dt, scene.contact_params(), f, t);
-    for (std::size_t i = 0; i < s.size(); ++i) {
-        const double inertia = sphere_inertia(s.radius[i], mass[i]);
-        s.trans.a[i] = {acceleration(f[i].x, mass[i], scene.gravity.x), acceleration(f[i].y, mass[i], scene.gravity.y),
-                        acceleration(f[i].z, mass[i], scene.gravity.z)};
-        s.rot.a[i] = {t[i].x / inertia, t[i].y / inertia, t[i].z / inertia};
-    }
+    initial_accelerations(scene, s);  // t = 0; b3 = b4 = b5 = 0 as resized
     return s;
 }
 

@@ -20,6 +20,11 @@ struct ContactParams {
     T gamma_t{};   // tangential viscous coefficient, 1/s
     T mu{};        // Coulomb friction coefficient
 
+    // The effective moduli E* themselves (physics.md §2, §8: contact time, maximum overlap), derived here
+    // only, from the stored (4/3)·E*.
+    T estar_pp() const { return T(0.75) * hertz_pp; }
+    T estar_pw() const { return T(0.75) * hertz_pw; }
+
     template <class U>
     ContactParams<U> as() const
     {

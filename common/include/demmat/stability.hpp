@@ -17,9 +17,13 @@ namespace demmat {
 double hertz_max_overlap(double mstar, double rstar, double estar, double speed);
 double hertz_contact_time(double mstar, double rstar, double estar, double speed);
 
-// The largest impact speed a scene can explain (docs/stability.md): v_p = fastest initial grain + a free
-// fall across the domain's diagonal + the fastest wall; two grains can meet head-on at 2·v_p, a single
-// grain meets a wall at v_p + the fastest wall.
+// The fastest a grain can move by what the scene explains, v_p = fastest initial grain + a free fall
+// across the domain's diagonal + the fastest wall (the driver's speed check allows ten times it).
+double explained_speed(const Scene& scene, const State& state);
+double fastest_wall_speed(const State& state);
+
+// The largest impact speed a scene can explain (docs/stability.md): two grains can meet head-on at 2·v_p,
+// a single grain meets a wall at v_p + the fastest wall.
 double impact_speed_bound(const Scene& scene, const State& state);
 
 // The shortest Hertz contact time of the scene at `speed`: the pair of two smallest grains, and (with

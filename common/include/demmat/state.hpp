@@ -62,6 +62,11 @@ std::vector<Wall> continue_walls(const Scene& scene, const State& saved);
 // Validates the particles (radii, overlaps, walls) and throws Error with one line on bad input.
 State initial_state(const Scene& scene);
 
+// The t = 0 accelerations of a state that starts afresh (design.md, decision 4): a = F(x, v)/m + g and
+// α = T/I, the forces and torques summed in the canonical order by the reference code (reference.hpp).
+// Sets trans.a and rot.a; the other Gear values are left as they are.
+void initial_accelerations(const Scene& scene, State& state);
+
 } // namespace demmat
 
 namespace demmat {
