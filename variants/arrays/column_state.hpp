@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "demmat/contact_law.hpp"
+#include "demmat/contact_memory.hpp"
 #include "demmat/gear.hpp"
 #include "demmat/integrators.hpp"
 #include "demmat/variant.hpp"
@@ -62,6 +63,7 @@ public:
         step_ = s.step;
         coef_ = SchemeCoefficients::make(scene.dt);
         params_ = setup.contact.template as<T>();
+        memory_ = setup.memory.template as<T>();
         g_ = cast<T>(scene.gravity);
         walls_ = s.walls;
         dt_ = scene.dt;
@@ -113,30 +115,54 @@ public:
     // The contact of particles i < j, if any, added to both: f_j = -f_i, and the torque of each.
     bool pair(std::size_t i, std::size_t j)
     {
+        if constexpr (law) {  // a §9 law without memory (restitution damping alone): no stretch to carry
+            Stretch<T> none;
+            return pair(i, j, none);
+        }
         const std::size_t n = n_;
         ContactForce<T> c;
         if (!particle_contact<M>(get(x_.data(), n, i), get(x_.data(), n, j), get(v_.data(), n, i), get(v_.data(), n, j),
                                  get(w_.data(), n, i), get(w_.data(), n, j), r_[i], r_[j], m_[i], m_[j], params_, mono_pp_, c))
             return false;
-        add(f_.data(), n, i, c.f_i);
-        add(f_.data(), n, j, -c.f_i);
-        if constexpr (M::rotation) {
-            add(t_.data(), n, i, c.t_i);
-            add(t_.data(), n, j, c.t_j);
-        }
+        add_pair(i, j, c);
+        return true;
+    }
+    // The same under a §9 law (contact_memory.hpp), with the pair's stretches `s` carried in and out.
+    bool pair(std::size_t i, std::size_t j, Stretch<T>& s)
+    {
+        const std::size_t n = n_;
+        ContactForce<T> c;
+        if (!particle_contact_memory<M>(get(x_.data(), n, i), get(x_.data(), n, j), get(v_.data(), n, i), get(v_.data(), n, j),
+                                        get(w_.data(), n, i), get(w_.data(), n, j), r_[i], r_[j], m_[i], m_[j], params_, memory_, s,
+                                        true, c))
+            return false;
+        add_pair(i, j, c);
         return true;
     }
 
     // The contact of particle i with wall w, if any, added to i.
     bool wall(std::size_t i, std::size_t w)
     {
+        if constexpr (law) {
+            Stretch<T> none;
+            return wall(i, w, none);
+        }
         const std::size_t n = n_;
         ContactForce<T> c;
         if (!wall_contact<M>(get(x_.data(), n, i), get(v_.data(), n, i), get(w_.data(), n, i), r_[i], m_[i], wall_point(w),
-                             wall_normal(w), Vec3<T>{wv_[3 * w], wv_[3 * w + 1], wv_[3 * w + 2]}, params_, mono_pw_, c))
+                             wall_normal(w), wall_velocity(w), params_, mono_pw_, c))
             return false;
-        add(f_.data(), n, i, c.f_i);
-        if constexpr (M::rotation) add(t_.data(), n, i, c.t_i);
+        add_wall(i, c);
+        return true;
+    }
+    bool wall(std::size_t i, std::size_t w, Stretch<T>& s)
+    {
+        const std::size_t n = n_;
+        ContactForce<T> c;
+        if (!wall_contact_memory<M>(get(x_.data(), n, i), get(v_.data(), n, i), get(w_.data(), n, i), r_[i], m_[i], wall_point(w),
+                                    wall_normal(w), wall_velocity(w), params_, memory_, s, true, c))
+            return false;
+        add_wall(i, c);
         return true;
     }
 
@@ -188,6 +214,24 @@ public:
     std::size_t memory_bytes() const { return 19 * 3 * n_ * sizeof(T); }
 
 private:
+    static constexpr bool law = M::restitution_damping || M::history || M::rolling;  // a §9 law, not the paper's
+
+    Vec3<T> wall_velocity(std::size_t w) const { return {wv_[3 * w], wv_[3 * w + 1], wv_[3 * w + 2]}; }
+    void add_pair(std::size_t i, std::size_t j, const ContactForce<T>& c)
+    {
+        add(f_.data(), n_, i, c.f_i);
+        add(f_.data(), n_, j, -c.f_i);
+        if constexpr (M::rotation) {
+            add(t_.data(), n_, i, c.t_i);
+            add(t_.data(), n_, j, c.t_j);
+        }
+    }
+    void add_wall(std::size_t i, const ContactForce<T>& c)
+    {
+        add(f_.data(), n_, i, c.f_i);
+        if constexpr (M::rotation) add(t_.data(), n_, i, c.t_i);
+    }
+
     void place_walls(std::int64_t step)
     {
         for (std::size_t w = 0; w < nw_; ++w) {
@@ -202,6 +246,7 @@ private:
     using SchemeCoefficients = typename S::template Coefficients<T>;  // the integrator's per-run constants
     SchemeCoefficients coef_;
     ContactParams<T> params_;
+    MemoryParams<T> memory_;  // the §9 law's constants (zero for the paper's law)
     Coefficients<T> mono_pp_, mono_pw_;  // monodisperse models: the one pair's and wall contact's coefficients
     Vec3<T> g_;
     std::vector<Wall> walls_;
