@@ -9,6 +9,8 @@
 #include <cstring>
 #include <fstream>
 #include <functional>
+#include <iterator>
+#include <string>
 
 #include <fmt/format.h>
 #include <gtest/gtest.h>
@@ -363,6 +365,19 @@ TEST(Memory, StateFileVersions)
         EXPECT_EQ(back.stretches[k].wall, st.stretches[k].wall);
         EXPECT_TRUE(back.stretches[k].tangential == st.stretches[k].tangential);
         EXPECT_TRUE(back.stretches[k].rolling == st.stretches[k].rolling);
+    }
+    // Damage to a contact's key is named, not read as a stretch of another contact: the first contact's
+    // partner (after the Gear values, at the end of the file less the checksum and C·72 bytes) set past N.
+    std::ifstream in("memory_v2.state", std::ios::binary);
+    std::string bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    const std::size_t first = bytes.size() - 8 - 72 * st.stretches.size();
+    const std::int64_t bad = 1000000;
+    std::memcpy(bytes.data() + first + 8, &bad, 8);
+    try {
+        parse_state(bytes, "damaged");
+        ADD_FAILURE() << "a contact naming particle 1000000 was read";
+    } catch (const Error& e) {
+        EXPECT_NE(std::string(e.what()).find("corrupt (contact 0 names particle"), std::string::npos) << e.what();
     }
     std::filesystem::remove("memory_v1.state");
     std::filesystem::remove("memory_v2.state");
