@@ -151,15 +151,8 @@ public:
         for (std::size_t i = 0; i < n; ++i) {
             const Index* row = &nl_.partner[i * std::size_t(nl_.cap)];
             candidates_ += nl_.count[i];
-            if constexpr (M::memory) {  // each contact takes its stretch by partner id and writes it back
-                auto old = pp_mem_.reader(i);
-                pp_mem_.begin_row(i);
-                for (Index k = 0; k < nl_.count[i]; ++k) {
-                    Stretch<T> s = old.take(row[k]);
-                    if (!state_.pair(i, std::size_t(row[k]), s)) continue;
-                    ++pp_;
-                    pp_mem_.put(i, row[k], s);
-                }
+            if constexpr (M::memory) {
+                pp_ += remembered(pp_mem_, i, row, nl_.count[i], [&](std::size_t j, Stretch<T>& s) { return state_.pair(i, j, s); });
             } else {
                 for (Index k = 0; k < nl_.count[i]; ++k)
                     if (state_.pair(i, std::size_t(row[k]))) ++pp_;
@@ -169,14 +162,7 @@ public:
             for (std::size_t i = 0; i < n; ++i) {
                 const Index* row = &bl_.wall[i * std::size_t(bl_.cap)];
                 if constexpr (M::memory) {
-                    auto old = pw_mem_.reader(i);
-                    pw_mem_.begin_row(i);
-                    for (Index k = 0; k < bl_.count[i]; ++k) {
-                        Stretch<T> s = old.take(row[k]);
-                        if (!state_.wall(i, std::size_t(row[k]), s)) continue;
-                        ++pw_;
-                        pw_mem_.put(i, row[k], s);
-                    }
+                    pw_ += remembered(pw_mem_, i, row, bl_.count[i], [&](std::size_t w, Stretch<T>& s) { return state_.wall(i, w, s); });
                 } else {
                     for (Index k = 0; k < bl_.count[i]; ++k)
                         if (state_.wall(i, std::size_t(row[k]))) ++pw_;
@@ -211,6 +197,23 @@ public:
     }
 
 private:
+    // Row i's contacts under a §9 law with memory (keys: partner ids or wall indices, ascending): each
+    // takes its stretch from the previous evaluation by key, and a contact that is live writes it back.
+    template <class Contact>
+    static std::int64_t remembered(StretchColumns<T>& mem, std::size_t i, const Index* row, Index count, Contact&& contact)
+    {
+        std::int64_t live = 0;
+        auto old = mem.reader(i);
+        mem.begin_row(i);
+        for (Index k = 0; k < count; ++k) {
+            Stretch<T> s = old.take(row[k]);
+            if (!contact(std::size_t(row[k]), s)) continue;
+            ++live;
+            mem.put(i, row[k], s);
+        }
+        return live;
+    }
+
     ColumnState<T, M, S> state_;
     T cell_ = T(0);
     NeighbourList nl_;
