@@ -431,4 +431,137 @@ TEST(Memory, SceneTableRoundTrips)
               "damping viscous, tangential linear_history (kt = 100 N/m, tangential_damping_ratio = 0.5), rolling none");
 }
 
+// ---- lanes -----------------------------------------------------------------------------------------
+
+template <class T>
+bool same_bits(T a, T b) { return std::memcmp(&a, &b, sizeof(T)) == 0; }
+
+// Packs of W pairs and wall contacts against the scalar §9 law, bit for bit, stretches included: random
+// geometry near contact, random velocities and spins, random stretches (some zero, some with a normal
+// part, some long enough to slide). Lanes out of contact keep their stretches and add zeros.
+template <class M, class T, int W>
+void check_memory_lanes(bool mindlin)
+{
+    using V = Pack<T, W>;
+    const ContactParams<T> p{T(4e5), T(6e5), T(60), T(60), T(0.4)};
+    MemoryParams<double> qd;
+    qd.alpha = 0.4;
+    qd.kt = 80.0;
+    qd.shear8_pp = 3e5;
+    qd.shear8_pw = 5e5;
+    qd.ratio_t = 0.5;
+    qd.kr = 60.0;
+    qd.gamma_r = 0.01;
+    qd.mu_r = 0.2;
+    qd.dt = 1e-5;
+    qd.mindlin = mindlin;
+    const MemoryParams<T> q = qd.as<T>();
+    std::uint64_t seed = 12345;
+    auto uniform = [&seed](double lo, double hi) {
+        seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+        return T(lo + (hi - lo) * double(seed >> 11) * 0x1.0p-53);
+    };
+    auto vec = [&](double a) { return Vec3<T>{uniform(-a, a), uniform(-a, a), uniform(-a, a)}; };
+    int touching = 0, sliding = 0;
+    for (int batch = 0; batch < 200; ++batch) {
+        Vec3<T> xi[W], xj[W], vi[W], vj[W], wi[W], wj[W];
+        T ri[W], rj[W], mi[W], mj[W];
+        Stretch<T> st[W];
+        for (int l = 0; l < W; ++l) {
+            ri[l] = uniform(0.003, 0.005);
+            rj[l] = uniform(0.003, 0.005);
+            mi[l] = T(1000.0 * 4.18879 * double(ri[l]) * double(ri[l]) * double(ri[l]));
+            mj[l] = T(1000.0 * 4.18879 * double(rj[l]) * double(rj[l]) * double(rj[l]));
+            const Vec3<T> dir = vec(1.0);
+            const T len = lane_sqrt(dot(dir, dir));
+            xi[l] = vec(0.01);
+            xj[l] = xi[l] + ((ri[l] + rj[l]) * uniform(0.97, 1.01) / len) * dir;
+            vi[l] = vec(0.5);
+            vj[l] = vec(0.5);
+            wi[l] = vec(50.0);
+            wj[l] = vec(50.0);
+            const double scale = (batch % 4 == 0) ? 0.0 : (batch % 4 == 1 ? 1e-6 : 1e-3);  // none, sticking, sliding
+            st[l] = {vec(scale), vec(scale)};
+        }
+        auto pack = [&](auto get) {
+            V v{};
+            for (int l = 0; l < W; ++l) v[l] = get(l);
+            return v;
+        };
+        auto pack3 = [&](const Vec3<T>* a) {
+            return Vec3<V>{pack([&](int l) { return a[l].x; }), pack([&](int l) { return a[l].y; }), pack([&](int l) { return a[l].z; })};
+        };
+        auto pack_stretch = [&] {
+            Vec3<T> t[W], r[W];
+            for (int l = 0; l < W; ++l) {
+                t[l] = st[l].t;
+                r[l] = st[l].r;
+            }
+            return Stretch<V>{pack3(t), pack3(r)};
+        };
+        // pairs
+        Stretch<V> sl = pack_stretch();
+        ContactForce<V> lanes;
+        const auto touch = particle_contact_memory_lanes<M>(pack3(xi), pack3(xj), pack3(vi), pack3(vj), pack3(wi), pack3(wj),
+                                                            pack([&](int l) { return ri[l]; }), pack([&](int l) { return rj[l]; }),
+                                                            pack([&](int l) { return mi[l]; }), pack([&](int l) { return mj[l]; }), p, q,
+                                                            sl, true, lanes);
+        // walls: the same particles i against a plane through xj with normal from xj towards xi
+        Vec3<T> wp[W], wn[W], wv[W];
+        for (int l = 0; l < W; ++l) {
+            const Vec3<T> d = xi[l] - xj[l];
+            wn[l] = d / lane_sqrt(dot(d, d));
+            wp[l] = xi[l] - (ri[l] * uniform(0.97, 1.01)) * wn[l];
+            wv[l] = vec(0.2);
+        }
+        Stretch<V> sw = pack_stretch();
+        ContactForce<V> wlanes;
+        const auto wtouch = wall_contact_memory_lanes<M>(pack3(xi), pack3(vi), pack3(wi), pack([&](int l) { return ri[l]; }),
+                                                         pack([&](int l) { return mi[l]; }), pack3(wp), pack3(wn), pack3(wv), p, q, sw,
+                                                         true, wlanes);
+        for (int l = 0; l < W; ++l) {
+            for (int kind = 0; kind < 2; ++kind) {
+                Stretch<T> one = st[l];
+                ContactForce<T> f;
+                const bool hit = kind == 0 ? particle_contact_memory<M>(xi[l], xj[l], vi[l], vj[l], wi[l], wj[l], ri[l], rj[l], mi[l], mj[l],
+                                                                        p, q, one, true, f)
+                                           : wall_contact_memory<M>(xi[l], vi[l], wi[l], ri[l], mi[l], wp[l], wn[l], wv[l], p, q, one,
+                                                                    true, f);
+                ASSERT_EQ(hit, (kind == 0 ? touch[l] : wtouch[l]) != 0);
+                if (!hit) f = ContactForce<T>{};
+                touching += hit;
+                const ContactForce<V>& g = kind == 0 ? lanes : wlanes;
+                const Stretch<V>& gs = kind == 0 ? sl : sw;
+                const Vec3<T>* want[5] = {&f.f_i, &f.t_i, &f.t_j, &one.t, &one.r};
+                const Vec3<V>* got[5] = {&g.f_i, &g.t_i, &g.t_j, &gs.t, &gs.r};
+                for (int k = 0; k < 5; ++k) {
+                    if (kind == 1 && k == 2) continue;  // a wall contact has no t_j
+                    for (int c = 0; c < 3; ++c)
+                        ASSERT_TRUE(same_bits(component(*want[k], c), component(*got[k], c)[l]))
+                            << (kind == 0 ? "pair" : "wall") << " lane " << l << " batch " << batch << " quantity " << k << " c " << c;
+                }
+                if (hit && kind == 0) {  // sliding: the tangential part of f_i has the length μ·F_n
+                    const Vec3<T> d = xj[l] - xi[l];
+                    const Vec3<T> n = d / lane_sqrt(dot(d, d));
+                    const T fn = -dot(f.f_i, n);
+                    const Vec3<T> ft = f.f_i + fn * n;
+                    const T ft_abs = lane_sqrt(dot(ft, ft));
+                    sliding += fn > T(0) && std::abs(double(ft_abs) - 0.4 * double(fn)) < 1e-4 * double(fn);
+                }
+            }
+        }
+    }
+    EXPECT_GT(touching, 200 * W / 2);
+    EXPECT_GT(sliding, 0);
+}
+
+TEST(Memory, EveryLaneOfAPackHasTheScalarLawsBits)
+{
+    using Law = Model<true, true, true, true, true, true, true, true, true>;
+    check_memory_lanes<Law, double, native_lanes<double>>(false);
+    check_memory_lanes<Law, double, native_lanes<double>>(true);
+    check_memory_lanes<Law, float, native_lanes<float>>(true);
+    check_memory_lanes<Model<true, true, true, true, true, true, false, true, false>, double, native_lanes<double>>(false);
+}
+
 } // namespace
