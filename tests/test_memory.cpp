@@ -303,10 +303,10 @@ TEST(Memory, StretchesSurviveAnySearch)
 
 TEST(Memory, SaveAndContinueIsBitIdenticalForEveryIntegrator)
 {
-    // In double: a float run's state file holds its radii rounded to float, so the masses of a continued
-    // float run are computed from other radii than the first run's (for every law, not only §9's).
+    // In float too: a float run saves the radii it was given, not their float roundings, so a continued run
+    // derives the same masses (before that fix, float save-and-continue differed for every law).
     for (const char* integrator : {"gear5", "gear3", "verlet", "symplectic_euler"})
-        for (const char* precision : {"double"}) {
+        for (const char* precision : {"double", "float"}) {
             const Scene s = memory_bed(integrator, precision);
             Case c(s);
             VariantRun straight("arrays", c.setup);

@@ -70,6 +70,7 @@ public:
         load_gear_columns<T>(s, {&x_, &v_, &a_, &b3_, &b4_, &b5_, &th_, &w_, &al_, &r3_, &r4_, &r5_});
         for (auto* arr : {&f_, &t_, &acc_, &alc_}) arr->assign(3 * n_, T(0));
         r_.resize(n_); m_.resize(n_); I_.resize(n_);
+        radius_ = s.radius;
         for (std::size_t i = 0; i < n_; ++i) {
             r_[i] = T(s.radius[i]);
             m_[i] = T(setup.mass[i]);
@@ -208,7 +209,7 @@ public:
                                        &out.rot.x,   &out.rot.v,   &out.rot.a,   &out.rot.b3,   &out.rot.b4,   &out.rot.b5};
         for (int k = 0; k < 12; ++k)
             for (std::size_t i = 0; i < n_; ++i) (*dst[k])[i] = cast<double>(get(src[k]->data(), n_, i));
-        for (std::size_t i = 0; i < n_; ++i) out.radius[i] = double(r_[i]);
+        out.radius = radius_;  // the given radii, not r_ rounded to T: a continued run derives the same masses
     }
 
     std::size_t memory_bytes() const { return 19 * 3 * n_ * sizeof(T); }
@@ -253,6 +254,7 @@ private:
     std::vector<T> x_, v_, a_, b3_, b4_, b5_, th_, w_, al_, r3_, r4_, r5_;  // (N, 3) each
     std::vector<T> f_, t_, acc_, alc_;                                      // (N, 3) each
     std::vector<T> r_, m_, I_;                                              // (N)
+    std::vector<double> radius_;                                            // (N) as given, for save()
     std::vector<T> wp_, wn_, wv_;                                           // (3, walls)
 };
 
