@@ -28,8 +28,7 @@ namespace {
 // ---- an independent reference: the head-on law in SI units, integrated with RK4 --------------------
 // m*·ḧ = −max(0, K·h^(3/2) + η_n(h)·ḣ), K = (4/3)·E*·sqrt(R*), η_n = α·sqrt(m*·(4/3)·E*·sqrt(R*·h))
 // (physics.md §9), from h = 0 at ḣ = v until h < 0 again. Written here from the formulas, in SI units
-// and with pow, not through the suite's code; the step is 1/20000 of the Hertz contact time (§8), fine
-// enough that halving it changes the rebound in the sixth digit.
+// and with pow, not through the suite's code; the step is 1/20000 of the Hertz contact time (§8).
 double reference_rebound(double alpha, double estar, double rstar, double mstar, double v)
 {
     const double K = 4.0 / 3.0 * estar * std::sqrt(rstar);
