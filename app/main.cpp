@@ -228,6 +228,8 @@ int cmd_run(const RunArgs& a)
     std::cout << fmt::format("variant {}  scene {}  particles {}  steps {}  t = {:.6g} s\n", info.name, l->scene().name,
                              l->state().size(), steps, driver.time());
     std::cout << fmt::format("integrator {}\n", l->scene().integrator.describe());
+    if (!l->scene().contact_model.is_paper())
+        std::cout << "contact law " << describe_law(l->scene().contact_model, l->setup().memory) << "\n";
     // The model instantiation the variant picked in init() (docs/design.md, "Model features").
     std::cout << fmt::format("model {}  (the scene needs {})\n", variant->model().name(),
                              features_of(l->scene(), l->state()).name());
@@ -454,6 +456,7 @@ struct SceneArgs {
     std::uint64_t seed = 1;
     std::int64_t max_layers = dense_bed_max_layers;
     double speed = 0.0, gap = 0.001;  // speed 0: the kind's default
+    std::vector<std::string> contact;  // --contact KEY=VALUE: the [contact] table (physics.md §9)
 };
 
 // Writes a scene only if `demmat run` would accept it: the options are checked by their validators (--n
@@ -478,6 +481,7 @@ int cmd_scene(const SceneArgs& a)
     } else {
         throw Error(fmt::format("unknown scene kind '{}' (expected paper, dense-bed, compression, head-on or drop)", a.kind));
     }
+    if (!a.contact.empty()) s.contact_model = contact_model_from_options(a.contact);
     {
         const State state = initial_state(s);
         check_time_step(s, state);  // throws above the stability limit; its warnings are run's to give
@@ -523,6 +527,7 @@ int main(int argc, char** argv)
     scene->add_option("--gap", sa.gap, "drop: initial gap between the sphere and the wall (m)")->check(number_from(0.0, false));
     scene->add_option("--from", sa.from, "compression: the scene that was settled");
     scene->add_option("--state", sa.state, "compression: the settled state file");
+    scene->add_option("--contact", sa.contact, "KEY=VALUE of the [contact] table, repeatable (e.g. tangential=mindlin); docs/scene-format.md");
 
     RunArgs ra;
     auto* run = app.add_subcommand("run", "Run a scene with one variant and report per-phase times");

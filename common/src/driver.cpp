@@ -18,6 +18,7 @@ Setup Setup::make(const Scene& scene, const State& state)
     s.scene = &scene;
     s.state = &state;
     s.contact = scene.contact_params();
+    s.memory = memory_params(scene);
     s.gear = GearCoefficients<double>::make(scene.dt);
     const std::size_t n = state.size();
     s.mass.resize(n);
@@ -38,6 +39,11 @@ void Registry::add(VariantInfo info)
             unavailable_.emplace_back(info.name, std::move(why));
             return;
         }
+    info.create = [make = std::move(info.create), name = info.name] {  // a variant knows its name, for messages
+        auto v = make();
+        v->set_registered_name(name);
+        return v;
+    };
     variants_.push_back(std::move(info));
 }
 
@@ -88,6 +94,11 @@ Driver::Driver(Variant& variant, const Setup& setup) : variant_(variant), setup_
     if (!variant_.supports(choice))
         throw Error(fmt::format("this variant integrates with gear5 in double only, not {} (the arrays variant runs "
                                 "every integrator and precision)", choice.describe()));
+    const ContactModel& law = setup.scene->contact_model;
+    if (!variant_.supports(law))
+        throw Error(fmt::format("{} computes the paper's contact law only, not {} (the arrays variant runs the laws of physics.md §9)",
+                                variant_.registered_name().empty() ? "this variant" : fmt::format("variant '{}'", variant_.registered_name()),
+                                law.describe()));
     variant_.init(setup_);
     const Scene& scene = *setup.scene;
     if (scene.checks.max_speed > 0.0) {

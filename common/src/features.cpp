@@ -35,6 +35,19 @@ ModelFeatures features_of(const Scene& scene, const State& state)
     for (const Wall& w : state.walls) f.moving_walls = f.moving_walls || set(w.velocity);
     for (double r : state.radius)
         if (std::memcmp(&r, &state.radius.front(), sizeof r) != 0) f.polydisperse = true;
+    const ModelFeatures law = law_features(scene.contact_model);
+    f.restitution_damping = law.restitution_damping;
+    f.history = law.history;
+    f.rolling = law.rolling;
+    return f;
+}
+
+ModelFeatures law_features(const ContactModel& law)
+{
+    ModelFeatures f;
+    f.restitution_damping = law.damping != NormalDamping::viscous;
+    f.history = law.tangential != TangentialModel::viscous;
+    f.rolling = law.rolling != RollingModel::none;
     return f;
 }
 

@@ -244,6 +244,9 @@ double liggghts_reference_sqrt_rdelta(const Scene& scene, const State& state)
 PeerExport export_peers(const Scene& scene, const State& state, const PeerOptions& options)
 {
     if (state.size() == 0) throw Error("export: the state has no particles");
+    if (!scene.contact_model.is_paper())  // a later change writes the §9 laws; a data file holds no stretches at all
+        throw Error(fmt::format("export: the scene's contact law ({}) is not exported: the LAMMPS fragment writes the paper's law "
+                                "only, and a LAMMPS data file cannot carry the contacts' stretches", scene.contact_model.describe()));
     PeerExport e;
     const double skin = options.skin > 0.0 ? options.skin : 0.5 * radius_min(state);
     e.data = data_file(scene, state);

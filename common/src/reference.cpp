@@ -56,10 +56,11 @@ std::vector<Pair> contact_pairs(const std::vector<Vec3d>& x, const std::vector<d
     return out;
 }
 
-void reference_forces(const std::vector<Vec3d>& x, const std::vector<Vec3d>& v, const std::vector<Vec3d>& w,
-                      const std::vector<double>& radius, const std::vector<double>& mass,
-                      const std::vector<Wall>& walls, std::int64_t step, double dt,
-                      const ContactParams<double>& params, std::vector<Vec3d>& force, std::vector<Vec3d>& torque)
+namespace {
+// Forces and torques in the canonical order, each contact by `pair(i, j, out)` and `wall(i, p, wall, out)`.
+template <class PairLaw, class WallLaw>
+void sum_forces(const std::vector<Vec3d>& x, const std::vector<double>& radius, const std::vector<Wall>& walls, std::int64_t step,
+                double dt, std::vector<Vec3d>& force, std::vector<Vec3d>& torque, PairLaw&& pair, WallLaw&& wall_law)
 {
     const std::size_t n = x.size();
     force.assign(n, Vec3d{});
@@ -68,8 +69,7 @@ void reference_forces(const std::vector<Vec3d>& x, const std::vector<Vec3d>& v, 
     // partners k < p ascending (as the j of earlier pairs), then partners l > p ascending.
     for (const auto& [i, j] : contact_pairs(x, radius, false)) {
         ContactForce<double> c;
-        if (!particle_contact<FullModel>(x[i], x[j], v[i], v[j], w[i], w[j], radius[i], radius[j], mass[i], mass[j], params, c))
-            continue;
+        if (!pair(std::size_t(i), std::size_t(j), c)) continue;
         force[i] += c.f_i;
         force[j] += -c.f_i;
         torque[i] += c.t_i;
@@ -79,11 +79,54 @@ void reference_forces(const std::vector<Vec3d>& x, const std::vector<Vec3d>& v, 
         const Vec3d p = wall.point_at(step, dt);
         for (std::size_t i = 0; i < n; ++i) {
             ContactForce<double> c;
-            if (!wall_contact<FullModel>(x[i], v[i], w[i], radius[i], mass[i], p, wall.normal, wall.velocity, params, c)) continue;
+            if (!wall_law(i, p, wall, c)) continue;
             force[i] += c.f_i;
             torque[i] += c.t_i;
         }
     }
+}
+} // namespace
+
+void reference_forces(const std::vector<Vec3d>& x, const std::vector<Vec3d>& v, const std::vector<Vec3d>& w,
+                      const std::vector<double>& radius, const std::vector<double>& mass,
+                      const std::vector<Wall>& walls, std::int64_t step, double dt,
+                      const ContactParams<double>& params, std::vector<Vec3d>& force, std::vector<Vec3d>& torque)
+{
+    sum_forces(
+        x, radius, walls, step, dt, force, torque,
+        [&](std::size_t i, std::size_t j, ContactForce<double>& c) {
+            return particle_contact<FullModel>(x[i], x[j], v[i], v[j], w[i], w[j], radius[i], radius[j], mass[i], mass[j], params, c);
+        },
+        [&](std::size_t i, const Vec3d& p, const Wall& wall, ContactForce<double>& c) {
+            return wall_contact<FullModel>(x[i], v[i], w[i], radius[i], mass[i], p, wall.normal, wall.velocity, params, c);
+        });
+}
+
+void reference_forces_law(const std::vector<Vec3d>& x, const std::vector<Vec3d>& v, const std::vector<Vec3d>& w,
+                          const std::vector<double>& radius, const std::vector<double>& mass,
+                          const std::vector<Wall>& walls, std::int64_t step, double dt, const ContactParams<double>& params,
+                          const MemoryParams<double>& memory, const ModelFeatures& law, std::vector<Vec3d>& force,
+                          std::vector<Vec3d>& torque)
+{
+    ModelFeatures need = ModelFeatures::full();
+    need.restitution_damping = law.restitution_damping;
+    need.history = law.history;
+    need.rolling = law.rolling;
+    with_law_model(need, [&]<class M>() {
+        if constexpr (M::restitution_damping || M::history || M::rolling)  // with_law_model's paper branch is never taken
+        sum_forces(
+            x, radius, walls, step, dt, force, torque,
+            [&](std::size_t i, std::size_t j, ContactForce<double>& c) {
+                Stretch<double> zero;
+                return particle_contact_memory<M>(x[i], x[j], v[i], v[j], w[i], w[j], radius[i], radius[j], mass[i], mass[j], params,
+                                                  memory, zero, false, c);
+            },
+            [&](std::size_t i, const Vec3d& p, const Wall& wall, ContactForce<double>& c) {
+                Stretch<double> zero;
+                return wall_contact_memory<M>(x[i], v[i], w[i], radius[i], mass[i], p, wall.normal, wall.velocity, params, memory, zero,
+                                              false, c);
+            });
+    });
 }
 
 } // namespace demmat

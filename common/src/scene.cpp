@@ -12,6 +12,7 @@
 #include <fmt/format.h>
 #include <toml.hpp>
 
+#include "contact_model_toml.hpp"
 #include "demmat/error.hpp"
 #include "demmat/io.hpp"
 
@@ -279,6 +280,7 @@ std::uint64_t Scene::fingerprint(std::size_t particle_count) const
     auto mixd = [&](double d) { mix(&d, sizeof d); };
     for (const Material* m : {&material, &wall_mat()})
         for (double d : {m->density, m->young, m->poisson, m->gamma_n, m->gamma_t, m->mu}) mixd(d);
+    for (double d : contact_model.fingerprint_values()) mixd(d);  // none for the paper's law
     mixd(dt);
     mixd(gravity.x); mixd(gravity.y); mixd(gravity.z);
     const std::uint64_t n = particle_count;
@@ -372,6 +374,8 @@ Scene parse_scene(const std::string& text, const std::string& label)
         if (!pr) t.fail(fmt::format("unknown precision '{}' (expected {})", precision, precision_names));
         s.integrator = {*sc, *pr};
     }
+
+    if (top.has("contact")) s.contact_model = parse_contact_model(top.raw("contact"), label);
 
     Table p = top.table("particles");
     const std::string source = p.string("source", "");
@@ -485,6 +489,7 @@ std::string scene_to_toml(const Scene& s)
     if (!s.integrator.is_default())  // written only when chosen, so default scenes read as before
         o += fmt::format("\n[integrator]\nscheme = \"{}\"\nprecision = \"{}\"\n", name(s.integrator.scheme),
                          name(s.integrator.precision));
+    if (!s.contact_model.is_paper()) o += "\n" + s.contact_model.toml();
     o += "\n[particles]\n";
     if (s.grid) {
         const GridGenerator& g = *s.grid;

@@ -1,5 +1,6 @@
 #include "demmat/state.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <fstream>
@@ -7,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "demmat/error.hpp"
+#include "demmat/features.hpp"
 #include "demmat/io.hpp"
 #include "demmat/reference.hpp"
 
@@ -15,7 +17,10 @@ namespace demmat {
 namespace {
 
 constexpr char kMagic[8] = {'D', 'E', 'M', 'M', 'A', 'T', 'S', 'T'};
-constexpr std::uint32_t kVersion = 1;
+// Version 2 adds the contacts' stretches (physics.md §9) after the Gear values; a state without any is
+// written as version 1, byte for byte as before they existed, and both versions read.
+constexpr std::uint32_t kVersion = 2;
+constexpr std::uint32_t kVersionWithoutStretches = 1;
 
 // splitmix64: a small, portable generator; the same seed gives the same scene on every machine
 // (std:: distributions are implementation-defined, so none is used).
@@ -106,6 +111,31 @@ void check_finite(const State& s, const std::string& label)
     bad(s.rot.b3, "rotational b3"); bad(s.rot.b4, "rotational b4"); bad(s.rot.b5, "rotational b5");
 }
 
+// The stretches of a version-2 file: keys in range and in the canonical order, values finite.
+void read_stretches(Reader& r, State& s)
+{
+    const auto count = r.get<std::uint64_t>();
+    // 9 eight-byte fields per contact; a count the file cannot hold is damage, not an allocation.
+    if (count == 0 || count > r.left() / (9 * 8)) r.fail(fmt::format("state file is truncated or corrupt ({} contacts announced)", count));
+    const auto n = std::int64_t(s.size()), nw = std::int64_t(s.walls.size());
+    s.stretches.resize(std::size_t(count));
+    for (std::size_t k = 0; k < count; ++k) {
+        ContactStretch& c = s.stretches[k];
+        c.i = r.get<std::int64_t>();
+        c.partner = r.get<std::int64_t>();
+        const auto wall = r.get<std::uint64_t>();
+        c.wall = wall == 1;
+        c.tangential = r.vec();
+        c.rolling = r.vec();
+        const bool key_ok = wall <= 1 && c.i >= 0 && c.i < n && (c.wall ? c.partner >= 0 && c.partner < nw : c.partner > c.i && c.partner < n);
+        if (!key_ok) r.fail(fmt::format("corrupt (contact {} names particle {} and {} {})", k, c.i, c.wall ? "wall" : "particle", c.partner));
+        if (k > 0 && !(s.stretches[k - 1] < c)) r.fail(fmt::format("corrupt (contact {} is out of order or repeated)", k));
+        for (const Vec3d& v : {c.tangential, c.rolling})
+            if (!std::isfinite(v.x) || !std::isfinite(v.y) || !std::isfinite(v.z))
+                r.fail(fmt::format("corrupt (contact {} has a non-finite stretch)", k));
+    }
+}
+
 void generate_grid(const Scene& scene, State& s)
 {
     const GridGenerator& g = *scene.grid;
@@ -190,7 +220,7 @@ void save_state(const State& s, const std::filesystem::path& file)
 {
     Writer w;
     w.bytes().append(kMagic, 8);
-    w.put(kVersion);
+    w.put(s.stretches.empty() ? kVersionWithoutStretches : kVersion);
     w.put(std::uint32_t(0));
     w.put(s.fingerprint);
     w.put(s.step);
@@ -207,6 +237,16 @@ void save_state(const State& s, const std::filesystem::path& file)
     for (double r : s.radius) w.put(r);
     for (const GearState* g : {&s.trans, &s.rot})
         for (const auto* a : {&g->x, &g->v, &g->a, &g->b3, &g->b4, &g->b5}) w.put(*a);
+    if (!s.stretches.empty()) {
+        w.put(std::uint64_t(s.stretches.size()));
+        for (const ContactStretch& c : s.stretches) {
+            w.put(c.i);
+            w.put(c.partner);
+            w.put(std::uint64_t(c.wall ? 1 : 0));
+            w.put(c.tangential);
+            w.put(c.rolling);
+        }
+    }
     const std::uint64_t sum = fnv1a(w.bytes());
     w.put(sum);
     write_atomically(file, w.bytes());
@@ -227,7 +267,8 @@ State parse_state(const std::string& bytes, const std::string& label)
     Reader r(bytes, label);
     r.get<std::uint64_t>();  // magic
     const auto version = r.get<std::uint32_t>();
-    if (version != kVersion) r.fail(fmt::format("state file version {} is not supported (expected {})", version, kVersion));
+    if (version != kVersion && version != kVersionWithoutStretches)
+        r.fail(fmt::format("state file version {} is not supported (expected {} or {})", version, kVersionWithoutStretches, kVersion));
     if (r.get<std::uint32_t>() != 0) r.fail("corrupt (the reserved header field is not zero)");
     State s;
     s.fingerprint = r.get<std::uint64_t>();
@@ -260,6 +301,7 @@ State parse_state(const std::string& bytes, const std::string& label)
     for (auto& x : s.radius) x = r.get<double>();
     for (GearState* g : {&s.trans, &s.rot})
         for (auto* a : {&g->x, &g->v, &g->a, &g->b3, &g->b4, &g->b5}) r.vecs(*a);
+    if (version == kVersion) read_stretches(r, s);
     const std::uint64_t expect = fnv1a(bytes.substr(0, r.pos()));
     const auto sum = r.get<std::uint64_t>();
     if (sum != expect) r.fail("state file is corrupt (checksum mismatch)");
@@ -273,7 +315,11 @@ void initial_accelerations(const Scene& scene, State& s)
     std::vector<double> mass(s.size());
     for (std::size_t i = 0; i < s.size(); ++i) mass[i] = sphere_mass(s.radius[i], scene.material.density);
     std::vector<Vec3d> f, t;
-    reference_forces(s.trans.x, s.trans.v, s.rot.v, s.radius, mass, s.walls, s.step, scene.dt, scene.contact_params(), f, t);
+    if (scene.contact_model.is_paper())
+        reference_forces(s.trans.x, s.trans.v, s.rot.v, s.radius, mass, s.walls, s.step, scene.dt, scene.contact_params(), f, t);
+    else  // a §9 law: zero stretches, not advanced (physics.md §9)
+        reference_forces_law(s.trans.x, s.trans.v, s.rot.v, s.radius, mass, s.walls, s.step, scene.dt, scene.contact_params(),
+                             memory_params(scene), law_features(scene.contact_model), f, t);
     for (std::size_t i = 0; i < s.size(); ++i) {
         const double inertia = sphere_inertia(s.radius[i], mass[i]);
         s.trans.a[i] = {acceleration(f[i].x, mass[i], scene.gravity.x), acceleration(f[i].y, mass[i], scene.gravity.y),
@@ -294,6 +340,20 @@ State initial_state(const Scene& scene)
                                     "particle count differ)", scene.name, scene.state_file.string()));
         s = saved;
         s.walls = continue_walls(scene, saved);
+        // A wall contact's stretch is keyed by the wall's index: re-key it to the scene's walls by name, and
+        // forget it where the scene has no such wall.
+        std::vector<ContactStretch> kept;
+        for (ContactStretch c : s.stretches) {
+            if (c.wall) {
+                const std::string& wname = saved.walls[std::size_t(c.partner)].name;
+                auto it = std::find_if(s.walls.begin(), s.walls.end(), [&](const Wall& w) { return w.name == wname; });
+                if (it == s.walls.end()) continue;
+                c.partner = it - s.walls.begin();
+            }
+            kept.push_back(c);
+        }
+        std::sort(kept.begin(), kept.end());
+        s.stretches = kept;
         return s;
     }
     s.walls = scene.walls;

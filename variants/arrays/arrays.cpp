@@ -1,175 +1,16 @@
-// The plain-arrays processor, the paper's DEMMAT_F90 in C++: procedural free functions over flat
-// arrays of shape (N, 3) stored column by column (x(i, c) at x[c·N + i], as Fortran stores them),
-// capacities fixed up front and checked (the paper's "control of overestimation"). The particles'
-// state and its phases are in demmat/column_state.hpp; this file holds the contact store and the search.
-#include <algorithm>
-#include <cmath>
-#include <cstdint>
-#include <vector>
-
-#include <fmt/format.h>
-
-#include "demmat/column_state.hpp"
-#include "demmat/error.hpp"
-#include "demmat/features.hpp"
-#include "demmat/linked_cells.hpp"
-#include "demmat/registry.hpp"
+// The arrays variant's registration and its instantiations for the paper's law (arrays_variant.hpp).
+#include "arrays_variant.hpp"
 
 namespace demmat {
 namespace {
 
-using Index = std::int32_t;
-
-// ---- contact search --------------------------------------------------------------------------------
-
-// Neighbour list: for particle i, its candidate partners j > i in ascending order, at most `cap`.
-struct NeighbourList {
-    Index cap = 0;
-    std::vector<Index> count;    // (N)
-    std::vector<Index> partner;  // (N, cap), row i at [i·cap]
-};
-
-// Boundary list: for particle i, the walls it may touch, in wall order.
-struct BoundaryList {
-    Index cap = 0;
-    std::vector<Index> count;  // (N)
-    std::vector<Index> wall;   // (N, cap)
-};
-
-// Every pair (the paper's "no cells"), O(N²).
-template <class T>
-void search_all_pairs(std::size_t n, const T* x, const T* r, NeighbourList& nl)
-{
-    CandidateOverflow over;
-    for (std::size_t i = 0; i < n; ++i) {
-        Index c = 0;
-        Index* row = &nl.partner[i * std::size_t(nl.cap)];
-        const Vec3<T> xi = get(x, n, i);
-        for (std::size_t j = i + 1; j < n; ++j) {
-            if (!may_touch(xi, get(x, n, j), r[i], r[j])) continue;
-            if (c < nl.cap) row[c] = Index(j);
-            ++c;
-        }
-        over.note(c, i);
-        nl.count[i] = std::min(c, nl.cap);
-    }
-    over.check(nl.cap);
-}
-
-// Linked cells (common/linked_cells.hpp); partners j > i stored in ascending order, as the canonical
-// order needs. On overflow the search goes on counting so the message can give the value that fits.
-template <class T>
-void search_cells(std::size_t n, const T* x, const T* r, T edge, LinkedCells& cells, NeighbourList& nl)
-{
-    cells.build(n, x, x + n, x + 2 * n, edge);
-    CandidateOverflow over;
-    for (std::size_t i = 0; i < n; ++i) {
-        Index c = 0;
-        Index* row = &nl.partner[i * std::size_t(nl.cap)];
-        const Vec3<T> xi = get(x, n, i);
-        const T ri = r[i];
-        cells.for_each_above(i, [&](std::size_t j) {
-            if (!may_touch(xi, get(x, n, j), ri, r[j])) return;
-            if (c < nl.cap) insert_ascending(row, c, Index(j));
-            ++c;
-        });
-        over.note(c, i);
-        nl.count[i] = std::min(c, nl.cap);
-    }
-    over.check(nl.cap);
-}
-
-template <class T, class M, class S>
-void search_walls(const ColumnState<T, M, S>& s, BoundaryList& bl)
-{
-    const std::size_t n = s.size(), nw = s.wall_count();
-    std::fill(bl.count.begin(), bl.count.end(), Index(0));
-    for (std::size_t w = 0; w < nw; ++w) {
-        const Vec3<T> p = s.wall_point(w), nv = s.wall_normal(w);
-        for (std::size_t i = 0; i < n; ++i) {
-            if (!may_touch_wall(get(s.x(), n, i), s.r()[i], p, nv)) continue;
-            Index& c = bl.count[i];
-            if (c == bl.cap)  // at most one entry per wall: the walls' count always fits
-                throw CapacityError(fmt::format("capacity.wall_contacts_per_particle = {} exceeded: particle {} touches more "
-                                                "walls; set it to {} (the number of walls)", bl.cap, i, nw));
-            bl.wall[i * std::size_t(bl.cap) + std::size_t(c++)] = Index(w);
-        }
-    }
-}
-
-// ---- the processor ---------------------------------------------------------------------------------
-
-// T: value type (double, float); M: model (model.hpp); S: integrator (integrators.hpp).
-template <class T, class M, class S = Gear5Scheme>
-class ArraysVariant final : public ColumnStateVariant<T, M, S> {
-    using ColumnStateVariant<T, M, S>::state_, ColumnStateVariant<T, M, S>::pp_, ColumnStateVariant<T, M, S>::pw_,
-        ColumnStateVariant<T, M, S>::candidates_;
-
-public:
-    void init(const Setup& setup) override
-    {
-        state_.load(setup);
-        const Scene& scene = *setup.scene;
-        const std::size_t n = state_.size();
-        cell_ = T(setup.cell_size);
-        nl_.cap = Index(scene.capacity.contacts_per_particle);
-        nl_.count.assign(n, 0);
-        nl_.partner.assign(n * std::size_t(nl_.cap), 0);
-        if constexpr (M::walls) {  // a model without walls holds no boundary list
-            bl_.cap = Index(scene.capacity.wall_contacts_per_particle);
-            bl_.count.assign(n, 0);
-            bl_.wall.assign(n * std::size_t(bl_.cap), 0);
-        }
-        cells_.reserve(n);
-    }
-
-    void search() override
-    {
-        const std::size_t n = state_.size();
-        if (cell_ > T(0)) search_cells(n, state_.x(), state_.r(), cell_, cells_, nl_);
-        else search_all_pairs(n, state_.x(), state_.r(), nl_);
-        if constexpr (M::walls) search_walls(state_, bl_);
-    }
-
-    void forces() override
-    {
-        state_.zero_loads();
-        pp_ = 0;
-        pw_ = 0;
-        candidates_ = 0;
-        const std::size_t n = state_.size();
-        for (std::size_t i = 0; i < n; ++i) {
-            const Index* row = &nl_.partner[i * std::size_t(nl_.cap)];
-            candidates_ += nl_.count[i];
-            for (Index k = 0; k < nl_.count[i]; ++k)
-                if (state_.pair(i, std::size_t(row[k]))) ++pp_;
-        }
-        if constexpr (M::walls)
-            for (std::size_t i = 0; i < n; ++i) {
-                const Index* row = &bl_.wall[i * std::size_t(bl_.cap)];
-                for (Index k = 0; k < bl_.count[i]; ++k)
-                    if (state_.wall(i, std::size_t(row[k]))) ++pw_;
-            }
-        state_.newton();
-    }
-
-    std::size_t memory_bytes() const override
-    {
-        return state_.memory_bytes() + (nl_.partner.size() + nl_.count.size() + bl_.wall.size() + bl_.count.size()) * sizeof(Index) +
-               cells_.memory_bytes();
-    }
-
-private:
-    T cell_ = T(0);
-    NeighbourList nl_;
-    BoundaryList bl_;
-    LinkedCells cells_;
-};
+using arrays::ArraysVariant;
 
 // The instantiation a run gets, picked in init(): the smallest model that covers what the scene needs
 // (with_model, model.hpp).
 std::unique_ptr<Variant> pick_arrays(const Setup& setup)
 {
+    if (!setup.scene->contact_model.is_paper()) return arrays::pick_arrays_law(setup);
     const IntegratorChoice& choice = setup.scene->integrator;
     if (choice.is_default())
         return with_model(model_for(setup), []<class M>() -> std::unique_ptr<Variant> {
@@ -189,7 +30,8 @@ std::unique_ptr<Variant> pick_arrays(const Setup& setup)
 void register_variant_arrays(Registry& r)
 {
     r.add({"arrays", "plain arrays, procedural, Fortran-90 style (the paper's DEMMAT_F90)",
-           [] { return std::make_unique<DispatchingVariant>(pick_arrays, /*all_integrators=*/true); }});
+           [] { return std::make_unique<DispatchingVariant>(pick_arrays, /*all_integrators=*/true,
+                                                             /*all_laws=*/true); }});
 }
 
 } // namespace demmat

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "demmat/contact_law.hpp"
+#include "demmat/contact_memory.hpp"
 #include "demmat/gear.hpp"
 #include "demmat/integrators.hpp"
 #include "demmat/variant.hpp"
@@ -63,12 +64,14 @@ public:
         step_ = s.step;
         coef_ = SchemeCoefficients::make(scene.dt);
         params_ = setup.contact.template as<T>();
+        memory_ = setup.memory.template as<T>();
         g_ = cast<T>(scene.gravity);
         walls_ = s.walls;
         dt_ = scene.dt;
         load_gear_columns<T>(s, {&x_, &v_, &a_, &b3_, &b4_, &b5_, &th_, &w_, &al_, &r3_, &r4_, &r5_});
         for (auto* arr : {&f_, &t_, &acc_, &alc_}) arr->assign(3 * n_, T(0));
         r_.resize(n_); m_.resize(n_); I_.resize(n_);
+        radius_ = s.radius;
         for (std::size_t i = 0; i < n_; ++i) {
             r_[i] = T(s.radius[i]);
             m_[i] = T(setup.mass[i]);
@@ -114,30 +117,54 @@ public:
     // The contact of particles i < j, if any, added to both: f_j = -f_i, and the torque of each.
     bool pair(std::size_t i, std::size_t j)
     {
+        if constexpr (law) {  // a §9 law without memory (restitution damping alone): no stretch to carry
+            Stretch<T> none;
+            return pair(i, j, none);
+        }
         const std::size_t n = n_;
         ContactForce<T> c;
         if (!particle_contact<M>(get(x_.data(), n, i), get(x_.data(), n, j), get(v_.data(), n, i), get(v_.data(), n, j),
                                  get(w_.data(), n, i), get(w_.data(), n, j), r_[i], r_[j], m_[i], m_[j], params_, mono_pp_, c))
             return false;
-        add(f_.data(), n, i, c.f_i);
-        add(f_.data(), n, j, -c.f_i);
-        if constexpr (M::rotation) {
-            add(t_.data(), n, i, c.t_i);
-            add(t_.data(), n, j, c.t_j);
-        }
+        add_pair(i, j, c);
+        return true;
+    }
+    // The same under a §9 law (contact_memory.hpp), with the pair's stretches `s` carried in and out.
+    bool pair(std::size_t i, std::size_t j, Stretch<T>& s)
+    {
+        const std::size_t n = n_;
+        ContactForce<T> c;
+        if (!particle_contact_memory<M>(get(x_.data(), n, i), get(x_.data(), n, j), get(v_.data(), n, i), get(v_.data(), n, j),
+                                        get(w_.data(), n, i), get(w_.data(), n, j), r_[i], r_[j], m_[i], m_[j], params_, memory_, s,
+                                        true, c))
+            return false;
+        add_pair(i, j, c);
         return true;
     }
 
     // The contact of particle i with wall w, if any, added to i.
     bool wall(std::size_t i, std::size_t w)
     {
+        if constexpr (law) {
+            Stretch<T> none;
+            return wall(i, w, none);
+        }
         const std::size_t n = n_;
         ContactForce<T> c;
         if (!wall_contact<M>(get(x_.data(), n, i), get(v_.data(), n, i), get(w_.data(), n, i), r_[i], m_[i], wall_point(w),
-                             wall_normal(w), Vec3<T>{wv_[3 * w], wv_[3 * w + 1], wv_[3 * w + 2]}, params_, mono_pw_, c))
+                             wall_normal(w), wall_velocity(w), params_, mono_pw_, c))
             return false;
-        add(f_.data(), n, i, c.f_i);
-        if constexpr (M::rotation) add(t_.data(), n, i, c.t_i);
+        add_wall(i, c);
+        return true;
+    }
+    bool wall(std::size_t i, std::size_t w, Stretch<T>& s)
+    {
+        const std::size_t n = n_;
+        ContactForce<T> c;
+        if (!wall_contact_memory<M>(get(x_.data(), n, i), get(v_.data(), n, i), get(w_.data(), n, i), r_[i], m_[i], wall_point(w),
+                                    wall_normal(w), wall_velocity(w), params_, memory_, s, true, c))
+            return false;
+        add_wall(i, c);
         return true;
     }
 
@@ -183,12 +210,30 @@ public:
                                        &out.rot.x,   &out.rot.v,   &out.rot.a,   &out.rot.b3,   &out.rot.b4,   &out.rot.b5};
         for (int k = 0; k < 12; ++k)
             for (std::size_t i = 0; i < n_; ++i) (*dst[k])[i] = cast<double>(get(src[k]->data(), n_, i));
-        for (std::size_t i = 0; i < n_; ++i) out.radius[i] = double(r_[i]);
+        out.radius = radius_;  // the given radii, not r_ rounded to T: a continued run derives the same masses
     }
 
     std::size_t memory_bytes() const { return 19 * 3 * n_ * sizeof(T); }
 
 private:
+    static constexpr bool law = M::restitution_damping || M::history || M::rolling;  // a §9 law, not the paper's
+
+    Vec3<T> wall_velocity(std::size_t w) const { return {wv_[3 * w], wv_[3 * w + 1], wv_[3 * w + 2]}; }
+    void add_pair(std::size_t i, std::size_t j, const ContactForce<T>& c)
+    {
+        add(f_.data(), n_, i, c.f_i);
+        add(f_.data(), n_, j, -c.f_i);
+        if constexpr (M::rotation) {
+            add(t_.data(), n_, i, c.t_i);
+            add(t_.data(), n_, j, c.t_j);
+        }
+    }
+    void add_wall(std::size_t i, const ContactForce<T>& c)
+    {
+        add(f_.data(), n_, i, c.f_i);
+        if constexpr (M::rotation) add(t_.data(), n_, i, c.t_i);
+    }
+
     void place_walls(std::int64_t step)
     {
         for (std::size_t w = 0; w < nw_; ++w) {
@@ -203,12 +248,14 @@ private:
     using SchemeCoefficients = typename S::template Coefficients<T>;  // the integrator's per-run constants
     SchemeCoefficients coef_;
     ContactParams<T> params_;
+    MemoryParams<T> memory_;  // the §9 law's constants (zero for the paper's law)
     Coefficients<T> mono_pp_, mono_pw_;  // monodisperse models: the one pair's and wall contact's coefficients
     Vec3<T> g_;
     std::vector<Wall> walls_;
     std::vector<T> x_, v_, a_, b3_, b4_, b5_, th_, w_, al_, r3_, r4_, r5_;  // (N, 3) each
     std::vector<T> f_, t_, acc_, alc_;                                      // (N, 3) each
     std::vector<T> r_, m_, I_;                                              // (N)
+    std::vector<double> radius_;                                            // (N) as given, for save()
     std::vector<T> wp_, wn_, wv_;                                           // (3, walls)
 };
 

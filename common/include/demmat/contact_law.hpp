@@ -103,6 +103,20 @@ DEMMAT_HD inline Coefficients<T> wall_coefficients(T ri, T mi, const ContactPara
 
 namespace detail {
 
+// The paper's tangential force from the tangential relative velocity u_t and the clipped F_n:
+// −min(μ·F_n, γ_t·m*·|u_t|)·u_t/|u_t| (ct = γ_t·m*), zero when |u_t| = 0.
+template <class T, class S>
+DEMMAT_HD inline Vec3<T> viscous_friction(const Vec3<T>& ut, T fn, T ct, S mu)
+{
+    const T zero{};
+    const T ut_abs = lane_sqrt(dot(ut, ut));
+    // No tangential force without tangential motion; the divisor 1 there keeps a lane finite.
+    const auto sliding = ut_abs > zero;
+    const T ft = lane_min(mu * fn, ct * ut_abs);
+    const Vec3<T> t = (-ft) * (ut / (sliding ? ut_abs : splat<T>(S(1))));
+    return {sliding ? t.x : zero, sliding ? t.y : zero, sliding ? t.z : zero};
+}
+
 // Normal and tangential force from the contact geometry (n from i towards the partner, overlap h > 0,
 // relative velocity u of i with respect to the partner at the contact point). The two branches of the
 // law (the clip and a zero tangential speed) are selects, so a pack of lanes runs the same code.
@@ -119,15 +133,7 @@ DEMMAT_HD inline void contact_force(const Vec3<T>& n, T h, const Vec3<T>& u, con
     if constexpr (M::damping) fn = fn + k.cn * un;
     fn = fn < zero ? zero : fn;  // choice: no attraction at the end of a contact
     f_t = Vec3<T>{};
-    if constexpr (M::friction) {
-        const Vec3<T> ut = u - un * n;
-        const T ut_abs = lane_sqrt(dot(ut, ut));
-        // No tangential force without tangential motion; the divisor 1 there keeps a lane finite.
-        const auto sliding = ut_abs > zero;
-        const T ft = lane_min(p.mu * fn, k.ct * ut_abs);
-        const Vec3<T> t = (-ft) * (ut / (sliding ? ut_abs : splat<T>(S(1))));
-        f_t = {sliding ? t.x : zero, sliding ? t.y : zero, sliding ? t.z : zero};
-    }
+    if constexpr (M::friction) f_t = viscous_friction(u - un * n, fn, k.ct, p.mu);
     f_i = (-fn) * n + f_t;
 }
 

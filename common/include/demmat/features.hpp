@@ -17,7 +17,9 @@ namespace demmat {
 // polydisperse: radii not all the same bits (masses and inertias follow from radius and density).
 // The state is needed, not the scene alone: a scene that continues a saved state gets its radii, spins
 // and walls from the state file.
+// The contact law's flags (physics.md §9) are the scene's [contact] choice, law_features.
 ModelFeatures features_of(const Scene& scene, const State& state);
+ModelFeatures law_features(const ContactModel& law);
 
 // What a variant must model for this setup: the scene's needs, widened by setup.widen (tests and
 // benchmarks run a more general model on purpose; nothing can narrow it).
@@ -31,8 +33,11 @@ class DispatchingVariant final : public Variant {
 public:
     using Pick = std::function<std::unique_ptr<Variant>(const Setup&)>;
     // all_integrators: pick() honours scene.integrator, every scheme and precision (integrators.hpp).
-    explicit DispatchingVariant(Pick pick, bool all_integrators = false) : pick_(std::move(pick)), all_integrators_(all_integrators) {}
+    // all_laws: pick() honours scene.contact_model, every law of physics.md §9 (with_law_model).
+    explicit DispatchingVariant(Pick pick, bool all_integrators = false, bool all_laws = false)
+        : pick_(std::move(pick)), all_integrators_(all_integrators), all_laws_(all_laws) {}
     bool supports(const IntegratorChoice& choice) const override { return all_integrators_ || choice.is_default(); }
+    bool supports(const ContactModel& law) const override { return all_laws_ || law.is_paper(); }
 
     void init(const Setup& setup) override
     {
@@ -52,6 +57,7 @@ public:
 private:
     Pick pick_;
     bool all_integrators_ = false;
+    bool all_laws_ = false;
     std::unique_ptr<Variant> impl_;
 };
 

@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "demmat/contact_law.hpp"
+#include "demmat/contact_memory.hpp"
+#include "demmat/model.hpp"
 #include "demmat/scene.hpp"
 #include "demmat/vec3.hpp"
 
@@ -23,5 +25,13 @@ void reference_forces(const std::vector<Vec3d>& x, const std::vector<Vec3d>& v, 
                       const std::vector<double>& radius, const std::vector<double>& mass,
                       const std::vector<Wall>& walls, std::int64_t step, double dt,
                       const ContactParams<double>& params, std::vector<Vec3d>& force, std::vector<Vec3d>& torque);
+
+// The same under a law of physics.md §9 (`law`: its flags, law_features), every contact with zero
+// stretches that are not advanced: the rule for the t = 0 accelerations (a fresh start has no history).
+void reference_forces_law(const std::vector<Vec3d>& x, const std::vector<Vec3d>& v, const std::vector<Vec3d>& w,
+                          const std::vector<double>& radius, const std::vector<double>& mass,
+                          const std::vector<Wall>& walls, std::int64_t step, double dt, const ContactParams<double>& params,
+                          const MemoryParams<double>& memory, const ModelFeatures& law, std::vector<Vec3d>& force,
+                          std::vector<Vec3d>& torque);
 
 } // namespace demmat

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "demmat/contact_law.hpp"
+#include "demmat/contact_model.hpp"
 #include "demmat/integrators.hpp"
 #include "demmat/vec3.hpp"
 
@@ -95,6 +96,7 @@ struct Scene {
     Capacity capacity;
     Checks checks;
     IntegratorChoice integrator;  // [integrator]; default gear5 in double (docs/accuracy.md)
+    ContactModel contact_model;   // [contact]; default the paper's law (physics.md §2, §9)
 
     // Exactly one of these is the particle source.
     std::optional<GridGenerator> grid;

@@ -18,6 +18,23 @@ struct GearState {  // six values per degree of freedom, for all particles
     void resize(std::size_t n) { x.resize(n); v.resize(n); a.resize(n); b3.resize(n); b4.resize(n); b5.resize(n); }
 };
 
+// One live contact's stretches (physics.md §9), keyed by ids, never by a slot: the pair (i, partner),
+// i < partner, or particle i and wall index `partner` when `wall`. A state holds them in the canonical
+// order (by i; then its particle partners ascending; then its walls in wall order).
+struct ContactStretch {
+    std::int64_t i = 0;
+    std::int64_t partner = 0;
+    bool wall = false;
+    Vec3d tangential, rolling;  // ξ and ξ_r, metres (zero where the law has no such spring)
+
+    bool operator<(const ContactStretch& o) const
+    {
+        if (i != o.i) return i < o.i;
+        if (wall != o.wall) return !wall;
+        return partner < o.partner;
+    }
+};
+
 struct State {
     std::int64_t step = 0;          // steps taken since the scene's t = 0; time = step·Δt
     double dt = 0.0;
@@ -26,6 +43,7 @@ struct State {
     GearState trans;                // position, velocity, acceleration, b3, b4, b5
     GearState rot;                  // orientation, angular velocity, angular acceleration, b3, b4, b5
     std::vector<Wall> walls;
+    std::vector<ContactStretch> stretches;  // every live contact's, for a §9 law with memory; else empty
 
     std::size_t size() const { return radius.size(); }
     void resize(std::size_t n) { radius.resize(n); trans.resize(n); rot.resize(n); }

@@ -3,9 +3,11 @@
 // it knows nothing of clocks, files or statistics: the driver calls the four phases and times them.
 #include <cstdint>
 #include <memory>
+#include <string>
 #include <vector>
 
 #include "demmat/contact_law.hpp"
+#include "demmat/contact_memory.hpp"
 #include "demmat/gear.hpp"
 #include "demmat/scene.hpp"
 #include "demmat/state.hpp"
@@ -18,6 +20,7 @@ struct Setup {
     const Scene* scene = nullptr;
     const State* state = nullptr;
     ContactParams<double> contact;
+    MemoryParams<double> memory;  // the constants of the scene's §9 law (contact_memory.hpp); zero for the paper's
     GearCoefficients<double> gear;
     std::vector<double> mass;     // per particle, id order (sphere_mass)
     std::vector<double> inertia;  // per particle, id order (sphere_inertia)
@@ -72,6 +75,16 @@ public:
     // Driver refuses a run whose variant does not. A variant that integrates with the paper's Gear scheme
     // in double only keeps this default.
     virtual bool supports(const IntegratorChoice& choice) const { return choice.is_default(); }
+    // Whether init() honours this contact law (scene.contact_model, physics.md §9); the Driver refuses a
+    // run whose variant does not. A variant that computes the paper's law only keeps this default.
+    virtual bool supports(const ContactModel& law) const { return law.is_paper(); }
+
+    // The name it is registered under (set by Registry::add's factory), for messages; empty otherwise.
+    const std::string& registered_name() const { return registered_name_; }
+    void set_registered_name(std::string name) { registered_name_ = std::move(name); }
+
+private:
+    std::string registered_name_;
 };
 
 } // namespace demmat

@@ -1,0 +1,206 @@
+// The scene's [contact] table (docs/scene-format.md): which law of physics.md §9 a run uses.
+#include "contact_model_toml.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <set>
+#include <sstream>
+
+#include <fmt/format.h>
+
+#include "demmat/error.hpp"
+
+namespace demmat {
+
+const char* name(NormalDamping d)
+{
+    switch (d) {
+    case NormalDamping::tsuji: return "tsuji";
+    case NormalDamping::restitution: return "restitution";
+    case NormalDamping::viscous: break;
+    }
+    return "viscous";
+}
+const char* name(TangentialModel t)
+{
+    switch (t) {
+    case TangentialModel::linear_history: return "linear_history";
+    case TangentialModel::mindlin: return "mindlin";
+    case TangentialModel::viscous: break;
+    }
+    return "viscous";
+}
+const char* name(RollingModel r) { return r == RollingModel::sds ? "sds" : "none"; }
+
+namespace {
+
+// The table's keys, each read at most once; a key the chosen models do not read is an error.
+class ContactTable {
+public:
+    ContactTable(const toml::value& v, std::string label) : v_(v), label_(std::move(label))
+    {
+        if (!v_.is_table()) fail("'contact' must be a table ([contact])");
+    }
+    [[noreturn]] void fail(const std::string& msg) const { throw Error(fmt::format("{}: {}", label_, msg)); }
+    bool has(const std::string& key) const { return v_.as_table().count(key) != 0; }
+
+    template <class E>
+    E model(const std::string& key, std::initializer_list<E> all)
+    {
+        if (!has(key)) return *all.begin();
+        used_.insert(key);
+        const auto& x = v_.as_table().at(key);
+        const std::string got = x.is_string() ? x.as_string().str : std::string();
+        std::string expected;
+        for (E e : all) {
+            if (got == name(e)) return e;
+            expected += (expected.empty() ? "" : ", ") + std::string(name(e));
+        }
+        if (!x.is_string()) fail(fmt::format("'contact.{}' must be a string ({})", key, expected));
+        fail(fmt::format("unknown contact.{} '{}' (expected {})", key, printable(got), expected));
+    }
+    // A number the chosen model needs: missing, not a number or not finite is an error naming the key.
+    double number(const std::string& key, const std::string& needed_by)
+    {
+        if (!has(key)) fail(fmt::format("missing key 'contact.{}' (needed by {})", key, needed_by));
+        used_.insert(key);
+        const auto& x = v_.as_table().at(key);
+        double d = 0.0;
+        if (x.is_floating()) d = x.as_floating();
+        else if (x.is_integer()) d = double(x.as_integer());
+        else fail(fmt::format("'contact.{}' must be a number", key));
+        if (!std::isfinite(d)) fail(fmt::format("'contact.{}' must be finite (got {})", key, d));
+        return d;
+    }
+    double positive(const std::string& key, const std::string& needed_by)
+    {
+        const double d = number(key, needed_by);
+        if (!(d > 0.0)) fail(fmt::format("'contact.{}' must be > 0 (got {})", key, d));
+        return d;
+    }
+    double non_negative(const std::string& key, const std::string& needed_by)
+    {
+        const double d = number(key, needed_by);
+        if (d < 0.0) fail(fmt::format("'contact.{}' must be >= 0 (got {})", key, d));
+        return d;
+    }
+    void close(const ContactModel& m) const
+    {
+        static const std::set<std::string> known = {"damping", "restitution", "tangential", "kt", "tangential_damping_ratio",
+                                                    "rolling", "kr", "rolling_damping", "rolling_friction"};
+        for (const auto& [key, _] : v_.as_table()) {
+            if (used_.count(key)) continue;
+            if (!known.count(key)) fail(fmt::format("unknown key '{}' in [contact]", printable(key)));
+            fail(fmt::format("'contact.{}' is not used by this law ({})", key, m.describe()));
+        }
+    }
+
+private:
+    static std::string printable(const std::string& s)
+    {
+        std::string out;
+        for (unsigned char c : s) out += (c < 0x20 || c == 0x7F) ? fmt::format("\\x{:02x}", c) : std::string(1, char(c));
+        return out;
+    }
+    const toml::value& v_;
+    std::string label_;
+    std::set<std::string> used_;
+};
+
+} // namespace
+
+ContactModel parse_contact_model(const toml::value& v, const std::string& label)
+{
+    ContactTable t(v, label);
+    ContactModel m;
+    m.damping = t.model("damping", {NormalDamping::viscous, NormalDamping::tsuji, NormalDamping::restitution});
+    m.tangential = t.model("tangential", {TangentialModel::viscous, TangentialModel::linear_history, TangentialModel::mindlin});
+    m.rolling = t.model("rolling", {RollingModel::none, RollingModel::sds});
+    if (m.damping != NormalDamping::viscous) {
+        const std::string by = fmt::format("damping = \"{}\"", name(m.damping));
+        m.restitution = t.number("restitution", by);
+        if (!(m.restitution > 0.0 && m.restitution <= 1.0))
+            t.fail(fmt::format("'contact.restitution' must lie in (0, 1] (got {})", m.restitution));
+    }
+    if (m.tangential != TangentialModel::viscous) {
+        const std::string by = fmt::format("tangential = \"{}\"", name(m.tangential));
+        if (m.tangential == TangentialModel::linear_history) m.kt = t.positive("kt", by);
+        m.tangential_damping_ratio = t.non_negative("tangential_damping_ratio", by);
+    }
+    if (m.rolling == RollingModel::sds) {
+        m.kr = t.positive("kr", "rolling = \"sds\"");
+        m.rolling_damping = t.non_negative("rolling_damping", "rolling = \"sds\"");
+        m.rolling_friction = t.non_negative("rolling_friction", "rolling = \"sds\"");
+    }
+    t.close(m);
+    return m;
+}
+
+std::string ContactModel::describe() const
+{
+    std::string s = fmt::format("damping {}", name(damping));
+    if (damping != NormalDamping::viscous) s += fmt::format(" (restitution = {})", restitution);
+    s += fmt::format(", tangential {}", name(tangential));
+    if (tangential == TangentialModel::linear_history)
+        s += fmt::format(" (kt = {} N/m, tangential_damping_ratio = {})", kt, tangential_damping_ratio);
+    if (tangential == TangentialModel::mindlin) s += fmt::format(" (tangential_damping_ratio = {})", tangential_damping_ratio);
+    s += fmt::format(", rolling {}", name(rolling));
+    if (rolling == RollingModel::sds)
+        s += fmt::format(" (kr = {} N/m, rolling_damping = {} N·s/m, rolling_friction = {})", kr, rolling_damping, rolling_friction);
+    return s;
+}
+
+std::string ContactModel::toml() const
+{
+    if (is_paper()) return {};
+    std::string o = "[contact]                          # the contact law (physics.md §9)\n";
+    o += fmt::format("damping = \"{}\"\n", name(damping));
+    if (damping != NormalDamping::viscous) o += fmt::format("restitution = {}\n", restitution);
+    o += fmt::format("tangential = \"{}\"\n", name(tangential));
+    if (tangential == TangentialModel::linear_history) o += fmt::format("kt = {}\n", kt);
+    if (tangential != TangentialModel::viscous) o += fmt::format("tangential_damping_ratio = {}\n", tangential_damping_ratio);
+    o += fmt::format("rolling = \"{}\"\n", name(rolling));
+    if (rolling == RollingModel::sds)
+        o += fmt::format("kr = {}\nrolling_damping = {}\nrolling_friction = {}\n", kr, rolling_damping, rolling_friction);
+    return o;
+}
+
+std::vector<double> ContactModel::fingerprint_values() const
+{
+    if (is_paper()) return {};
+    return {double(int(damping)), restitution, double(int(tangential)), kt, tangential_damping_ratio, double(int(rolling)), kr,
+            rolling_damping, rolling_friction};
+}
+
+ContactModel contact_model_from_options(const std::vector<std::string>& key_values)
+{
+    std::string text = "[contact]\n";
+    for (const std::string& kv : key_values) {
+        const auto eq = kv.find('=');
+        if (eq == std::string::npos || eq == 0)
+            throw Error(fmt::format("--contact '{}': expected KEY=VALUE (keys as in the scene's [contact] table)", kv));
+        const std::string key = kv.substr(0, eq), value = kv.substr(eq + 1);
+        for (char c : key)
+            if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) throw Error(fmt::format("--contact '{}': not a key", kv));
+        char* end = nullptr;
+        std::strtod(value.c_str(), &end);
+        const bool number = !value.empty() && *end == '\0';
+        std::string quoted = "\"";
+        for (char c : value) {
+            if (static_cast<unsigned char>(c) < 0x20) throw Error(fmt::format("--contact '{}': control character in the value", key));
+            if (c == '"' || c == '\\') quoted += '\\';
+            quoted += c;
+        }
+        text += key + " = " + (number ? value : quoted + "\"") + "\n";
+    }
+    toml::value root;
+    try {
+        std::istringstream in(text);
+        root = toml::parse(in, "--contact");
+    } catch (const std::exception&) {
+        throw Error("--contact: the options do not make a valid [contact] table (a key given twice, or a malformed number)");
+    }
+    return parse_contact_model(root.at("contact"), "--contact");
+}
+
+} // namespace demmat
