@@ -290,7 +290,7 @@ int cmd_compare(const std::string& scene, const std::string& variants, std::int6
         std::erase_if(names, [](const std::string& n) { return !registry().find(n).bitwise; });
         if (!left_out.empty())
             std::cout << fmt::format("left out: {} (not bit-identical by design: {} not keep the canonical order of force "
-                                     "summation; name {} in --variants to see how far {} drift)\n",
+                                     "summation; name {} in --variants to see how far {} drifts)\n",
                                      fmt::join(left_out, ", "), left_out.size() == 1 ? "it does" : "they do",
                                      left_out.size() == 1 ? "it" : "them", left_out.size() == 1 ? "it" : "they");
     }
