@@ -43,6 +43,16 @@ struct VariantRun {
     }
 };
 
+// The state a run has reached, as `demmat run --save` writes it (with Δt and the scene's fingerprint).
+inline State saved_state(const VariantRun& run, const Problem& p)
+{
+    State st;
+    run.variant->save(st);
+    st.dt = p.scene().dt;
+    st.fingerprint = p.state().fingerprint;
+    return st;
+}
+
 // The dense bed of 2000 particles after 12000 steps (0.12 s) of settling from its loose grid: it has
 // collapsed into a contact-rich bed (about 3.5 contacts per particle, rising to 4.4 over the next
 // 5000 steps). Computed once with the arrays variant and cached beside the tests (each ctest is its

@@ -29,11 +29,7 @@ Problem small_bed(double wall_speed)
         Problem c(bed);
         VariantRun run("arrays", c.setup());
         run.driver->run(15000);
-        State st;
-        run.variant->save(st);
-        st.dt = bed.dt;
-        st.fingerprint = c.state().fingerprint;
-        return st;
+        return saved_state(run, c);
     }();
     State st = settled;
     Scene s = wall_speed > 0 ? compression_scene(bed, "(settled in memory)", wall_speed) : bed;

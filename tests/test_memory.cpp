@@ -312,10 +312,7 @@ TEST(Memory, SaveAndContinueIsBitIdenticalForEveryIntegrator)
             straight.driver->run(2000);
             VariantRun first("arrays", c.setup());
             first.driver->run(1000);
-            State saved;
-            first.variant->save(saved);
-            saved.dt = s.dt;
-            saved.fingerprint = c.state().fingerprint;
+            const State saved = saved_state(first, c);
             EXPECT_GT(saved.stretches.size(), 50u) << integrator;
             const std::filesystem::path file = fmt::format("memory_{}_{}.state", integrator, precision);
             save_state(saved, file);
