@@ -142,8 +142,17 @@ void check_run_outputs(const RunArgs& a, const Scene& s)
         check_output_folder(a.vtk_dir, "--vtk");
         const fs::path pvd = fs::path(a.vtk_dir) / (safe_file_stem(s.name) + ".pvd");
         check_output_path(pvd, "--vtk", inputs);
-        for (const std::string* f : {&a.json_file, &a.save_file})
+        for (const std::string* f : {&a.json_file, &a.save_file, &a.log_file})
             if (!f->empty() && same_file(*f, pvd)) throw Error(fmt::format("{} is also the VTK series of --vtk", *f));
+    }
+    if (!a.log_file.empty()) {
+        for (const std::string* f : {&a.json_file, &a.save_file})
+            if (!f->empty() && same_file(*f, a.log_file)) throw Error(fmt::format("--log and another output name the same file {}", *f));
+        // The log evaluates energies and wall forces with the paper's law (it has no access to the
+        // variant's stretches): under a law of physics.md §9 its columns would be wrong, so it refuses.
+        if (!s.contact_model.is_paper())
+            throw Error("--log computes energies and wall forces with the paper's contact law only; this scene's [contact] law is "
+                        "not supported by the run log yet");
     }
 }
 

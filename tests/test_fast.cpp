@@ -205,8 +205,8 @@ TEST(Fast, UnorderedDiffersFromArraysOnlyByTheSummationOrder)
 
     // Over the next steps the bed amplifies those last bits. How far a difference of summation order
     // alone carries the bed over this horizon is measured, not assumed: fast_unordered on 1 and 3
-    // threads sums in other orders again (the loads of other threads), so the largest gap among the
-    // three runs at any step is what order alone gives here. The gap to arrays is a difference of the
+    // threads sums in other orders again (the loads of other threads), so the largest gap between
+    // those two runs at any step is what order alone gives here. The gap to arrays is a difference of the
     // same kind and must stay within a margin of that (10x: such gaps scatter within a few times each
     // other while they grow alike); a contact dropped or computed twice is no rounding, it changes a
     // force by the contact's own size and leaves that bound within a few steps. (A one-ulp nudge of
@@ -237,12 +237,14 @@ TEST(Fast, UnorderedDiffersFromArraysOnlyByTheSummationOrder)
         set_threads(3);
         others[1]->driver->step();
         const Snapshot u = unordered.snapshot(), u1 = others[0]->snapshot(), u3 = others[1]->snapshot();
-        order = std::max({order, largest_gap(u, u1), largest_gap(u, u3), largest_gap(u1, u3)});
+        // The yardstick from the two runs not under test, so that a fault of the 2-thread run alone
+        // cannot widen it.
+        order = std::max(order, largest_gap(u1, u3));
         worst = std::max(worst, largest_gap(ref.snapshot(), u));
     }
-    std::cout << "over " << steps + 1 << " steps: order alone (fast_unordered on 1, 2, 3 threads) " << order
+    std::cout << "over " << steps + 1 << " steps: order alone (fast_unordered on 1 and 3 threads) " << order
               << " m; fast_unordered against arrays " << worst << " m\n";
-    EXPECT_GT(order, 0.0) << "the three orders gave the same bits: no yardstick";
+    EXPECT_GT(order, 0.0) << "the two orders gave the same bits: no yardstick";
     EXPECT_LT(worst, 10.0 * order);
     set_threads(0);
 }

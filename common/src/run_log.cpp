@@ -40,8 +40,9 @@ LogRow measure_log_row(const Snapshot& s, const Setup& setup)
         }
     r.elastic = elastic_energy(s.position, st.radius, st.walls, s.step, dt, setup.contact);
 
-    // Contacts through the law itself (h > 0 exactly as the variants decide it). The full model: a
-    // scene's own model differs only by terms that are zero for it, so the forces are the same.
+    // Contacts through the law itself (h > 0 exactly as the variants decide it). The paper's full model:
+    // a scene's own model of that law differs only by terms that are zero for it, so the forces are the
+    // same (a law of physics.md §9 needs the variant's stretches: demmat run refuses --log for it).
     for (const auto& [i, j] : contact_pairs(s.position, st.radius, false)) {
         ContactForce<double> c;
         if (!particle_contact<FullModel>(s.position[i], s.position[j], s.velocity[i], s.velocity[j], s.angular_velocity[i],
