@@ -21,6 +21,7 @@ The figures share: one colour and marker per variant (STYLE), a provenance foote
 figure's width, legends outside the axes, and an atomic save (atomic_io).
 """
 import json
+import sys
 import os
 import textwrap
 from dataclasses import dataclass, field
@@ -114,13 +115,18 @@ def load_paper(path=PAPER_JSON):
 
 
 def _bench(path, raw):
-    df = pd.DataFrame(raw["samples"], columns=["variant", "threads", "repetition", "phase", "seconds_per_step"])
-    df = df.rename(columns={"seconds_per_step": "seconds"}).fillna({"threads": 0})
+    df = pd.DataFrame(raw["samples"])
+    if "threads_asked" not in df:  # older files: the count asked was the only one recorded
+        df["threads_asked"] = df.get("threads", 0)
+    df = df[["variant", "threads", "threads_asked", "repetition", "phase", "seconds_per_step"]]
+    df = df.rename(columns={"seconds_per_step": "seconds"}).fillna({"threads": 0, "threads_asked": 0})
     df["N"] = raw["scene"]["particles"]
-    df["sample"] = df.groupby(["variant", "threads", "repetition"], sort=False).ngroup()
+    # One sample per configuration asked for and repetition: `threads` is the count a variant really ran
+    # on (fast runs small beds on one thread whatever is asked), so two configurations may share it.
+    df["sample"] = df.groupby(["variant", "threads_asked", "repetition"], sort=False).ngroup()
     meta = {k: v for k, v in raw.items() if k not in ("samples", "provenance")}
     return Result("bench", path, normalise_provenance(raw["provenance"]),
-                  df[["variant", "threads", "N", "phase", "repetition", "seconds", "sample"]], meta)
+                  df[["variant", "threads", "threads_asked", "N", "phase", "repetition", "seconds", "sample"]], meta)
 
 
 def _run(path, raw):
@@ -145,7 +151,10 @@ def _gbench(path, raw):
                                  **raw.get("provenance", {})}, ctx)
     rows = []
     for b in raw["benchmarks"]:
-        if b.get("run_type") != "iteration" or not b.get("label") or b.get("error_occurred"):
+        if b.get("error_occurred"):  # a benchmark that failed is said, not silently dropped
+            print(f"results.py: {path}: {b.get('name')} failed: {b.get('error_message', '?')}", file=sys.stderr)
+            continue
+        if b.get("run_type") != "iteration" or not b.get("label"):
             continue
         row = json.loads(b["label"])  # the label's fields win over Google Benchmark's (its threads is always 1)
         if "particles" in row:

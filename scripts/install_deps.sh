@@ -12,6 +12,7 @@ required=(
   libeigen3-dev
   gfortran fp-compiler
   python3 python3-pandas python3-matplotlib
+  time
 )
 optional=(lammps liggghts valgrind)
 fuzz=(clang-14 libclang-rt-14-dev)

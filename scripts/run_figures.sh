@@ -35,7 +35,7 @@ echo "== benchmark ($sweep sweep, $reps randomly interleaved repetitions)"
 "$BUILD_DIR/bench/demmat_bench" --sweep="$sweep" --states-dir=states \
   --benchmark_repetitions="$reps" --benchmark_enable_random_interleaving=true \
   --benchmark_out="$tmp/bench.json" --benchmark_out_format=json --benchmark_counters_tabular=false \
-  --benchmark_format=console | grep -E "^(phases|figure4|cellsize|stream)/" | grep -vE "_(mean|median|stddev|cv) " | cut -c1-110 || true
+  --benchmark_format=console | { grep -E "^(phases|figure4|cellsize|stream)/" | grep -vE "_(mean|median|stddev|cv) " | cut -c1-110 || true; }
 mv "$tmp/bench.json" "$out/bench.json"
 
 callgrind=()

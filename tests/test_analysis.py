@@ -27,17 +27,38 @@ class Loader(unittest.TestCase):
     def test_demmat_bench(self):
         r = results.load(os.path.join(DATA, "bench_sample.json"))
         self.assertEqual(r.kind, "bench")
-        self.assertEqual(list(r.table.columns), TIDY)
+        # demmat bench also records the thread count asked for beside the one a variant ran on
+        self.assertEqual([c for c in r.table.columns if c != "threads_asked"], TIDY)
+        self.assertIn("threads_asked", r.table.columns)
         self.assertIs(r.provenance["dirty"], False)
         self.assertEqual(len(r.table), 16)  # 2 variants × 2 repetitions × 4 phases
         row = r.table[(r.table.variant == "arrays") & (r.table.repetition == 0) & (r.table.phase == "predict")]
         self.assertEqual(row.seconds.tolist(), [1.5135653999999999e-05])
         self.assertEqual(set(r.table.N), {2000})
         self.assertEqual(set(r.table[r.table.variant == "fast"].threads), {2})
+
         w = results.wide(r.table)
         self.assertEqual(len(w), 4)  # one row per sample
         a0 = w[(w.variant == "arrays") & (w.repetition == 0)].iloc[0]
         self.assertAlmostEqual(a0.total_s, a0.predict_s + a0.search_s + a0.forces_s + a0.correct_s, delta=0)
+
+    def test_two_configurations_on_the_same_threads_stay_two_samples(self):
+        # fast asked for 1 and 2 threads on a small bed runs on 1 both times: still two samples each
+        import json, tempfile
+        raw = json.load(open(os.path.join(DATA, "bench_sample.json")))
+        extra = [dict(x, threads=1, threads_asked=1) for x in raw["samples"] if x["variant"] == "fast"]
+        for x in raw["samples"]:
+            if x["variant"] == "fast":
+                x["threads"], x["threads_asked"] = 1, 2
+        raw["samples"] += extra
+        with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as f:
+            json.dump(raw, f)
+        r = results.load(f.name)
+        os.unlink(f.name)
+        fast = r.table[r.table.variant == "fast"]
+        self.assertEqual(set(fast.threads), {1})
+        self.assertEqual(fast["sample"].nunique(), 4)  # 2 configurations × 2 repetitions
+        self.assertEqual(len(results.wide(r.table)), 6)
 
     def test_google_benchmark(self):
         r = results.load(os.path.join(DATA, "gbench_sample.json"))
