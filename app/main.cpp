@@ -289,9 +289,10 @@ int cmd_run(const RunArgs& a)
 // ---- demmat compare ----------------------------------------------------------------------------------
 int cmd_compare(const std::string& scene, const std::string& variants, std::int64_t steps, double time, bool allow_unstable)
 {
-    auto l = load(scene, allow_unstable);
-    // A variant may be named twice: two instances must agree too (run-to-run determinism).
+    // A variant may be named twice: two instances must agree too (run-to-run determinism). The names are
+    // checked before the scene's state is made.
     auto names = variant_list(variants, true);
+    auto l = load(scene, allow_unstable);
     if (variants == "all") {  // every variant that promises bit identity (fast_unordered drops it on purpose)
         std::vector<std::string> left_out;
         for (const std::string& n : names)
@@ -364,11 +365,11 @@ struct BenchConfig {
 
 int cmd_bench(const BenchArgs& a)
 {
+    const auto names = variant_list(a.variants);  // the cheap checks before the scene's state is made
+    const std::vector<int> counts_asked = thread_counts(a.threads);
     auto l = load(a.scene, a.allow_unstable, [&](const Scene& s) {
         if (!a.json_file.empty()) check_output_path(a.json_file, "--json", scene_inputs(s));
     });
-    const auto names = variant_list(a.variants);
-    const std::vector<int> counts_asked = thread_counts(a.threads);
     std::vector<BenchConfig> configs;
     for (const auto& name : names) {
         if (!registry().find(name).threaded) configs.push_back({name, 1});
