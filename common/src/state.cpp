@@ -254,8 +254,10 @@ void save_state(const State& s, const std::filesystem::path& file)
 
 State load_state(const std::filesystem::path& file)
 {
-    // The largest file the format allows: the header, 1024 walls with names of 4096 bytes, 2^31 - 1
-    // particles of 37 doubles, the checksum (a regular file only: read_input_file refuses devices).
+    // A bound that stops a device or a runaway file, not the format's exact maximum: the header, 1024
+    // walls with names of 4096 bytes, 2^31 - 1 particles of 37 doubles, the checksum. A version-2 file's
+    // stretch block (80 bytes a contact) fits within it for any bed small enough to hold in memory.
+    // (A regular file only: read_input_file refuses devices.)
     constexpr std::uintmax_t kMaxStateBytes = 56 + 1024 * (4 + 4096 + 9 * 8 + 8) + std::uintmax_t(2147483647) * 37 * 8 + 8;
     return parse_state(read_input_file(file, "state file", kMaxStateBytes), file.string());
 }
