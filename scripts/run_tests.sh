@@ -11,6 +11,7 @@
 #   --build-dir DIR  the normal build folder (default build, or $DEMMAT_BUILD_DIR); the sanitizer build
 #                    goes in DIR-asan
 #   anything else goes to ctest, e.g. scripts/run_tests.sh --sanitize -R bad_input
+# The tests labelled `long` (the full matrices) are left out: scripts/run_long_tests.sh runs them.
 source "$(dirname "$0")/lib.sh"
 which=both; ctest_args=()
 while [[ $# -gt 0 ]]; do
@@ -35,7 +36,7 @@ run_build() {  # run_build DIR [cmake flags...]: every target, then every test
   shift
   echo "== run_tests: $dir" >&2
   cmake_build "$dir" -- "$@"
-  (cd "$dir" && ctest --output-on-failure -j "$JOBS" "${ctest_args[@]}")
+  (cd "$dir" && ctest --output-on-failure -j "$JOBS" -LE long "${ctest_args[@]}")
 }
 
 if [[ $which != sanitize ]]; then
