@@ -25,6 +25,7 @@
 #include "demmat/registry.hpp"
 #include "demmat/run_log.hpp"
 #include "demmat/text.hpp"
+#include "demmat/chung_ooi.hpp"
 #include "demmat/scenes.hpp"
 #include "demmat/stability.hpp"
 #include "demmat/threads.hpp"
@@ -467,6 +468,8 @@ struct SceneArgs {
     std::int64_t max_layers = dense_bed_max_layers;
     double speed = 0.0, gap = 0.001;  // speed 0: the kind's default
     std::vector<std::string> contact;  // --contact KEY=VALUE: the [contact] table (physics.md §9)
+    ChungOoiCase chung_ooi{0};         // chung-ooi (test 0: --test not given): --test, --material, --value, --law, --per-tc
+    bool chung_ooi_value = false;      // --value given (else the test's first)
 };
 
 // Writes a scene only if `demmat run` would accept it: the options are checked by their validators (--n
@@ -485,11 +488,18 @@ int cmd_scene(const SceneArgs& a)
     else if (a.kind == "dense-bed") s = dense_bed_scene(a.count > 0 ? a.count : 2000, a.seed, a.max_layers);
     else if (a.kind == "head-on") s = head_on_scene(a.speed > 0.0 ? a.speed : 1.0);
     else if (a.kind == "drop") s = drop_scene(a.gap);
+    else if (a.kind == "chung-ooi") {
+        if (a.chung_ooi.test == 0) throw Error("scene chung-ooi needs --test K (1 to 8, Chung & Ooi 2011; docs/validation.md)");
+        if (!a.contact.empty()) throw Error("scene chung-ooi: the law is chosen with --law (paper, restitution, linear_history, mindlin), not --contact");
+        ChungOoiCase c = a.chung_ooi;
+        if (!a.chung_ooi_value) c.value = chung_ooi_test(c.test).values.front();
+        s = chung_ooi_scene(c);
+    }
     else if (a.kind == "compression") {
         if (a.from.empty() || a.state.empty()) throw Error("scene compression needs --from SCENE and --state STATE");
         s = compression_scene(load_scene(a.from), a.state, a.speed > 0.0 ? a.speed : 0.5);
     } else {
-        throw Error(fmt::format("unknown scene kind '{}' (expected paper, dense-bed, compression, head-on or drop)", a.kind));
+        throw Error(fmt::format("unknown scene kind '{}' (expected paper, dense-bed, compression, head-on, drop or chung-ooi)", a.kind));
     }
     if (!a.contact.empty()) s.contact_model = contact_model_from_options(a.contact);
     {
@@ -525,7 +535,7 @@ int main(int argc, char** argv)
 
     SceneArgs sa;
     auto* scene = app.add_subcommand("scene", "Write a standard scene as an editable TOML file (to stdout without --out)");
-    scene->add_option("kind", sa.kind, "paper | dense-bed | compression | head-on | drop")->required();
+    scene->add_option("kind", sa.kind, "paper | dense-bed | compression | head-on | drop | chung-ooi")->required();
     scene->add_option("--out,-o", sa.out, "Output file");
     constexpr std::int64_t int_max = 2147483647, int64_max = std::numeric_limits<std::int64_t>::max();
     scene->add_option("--n", sa.count, "Number of particles (paper: 1000, dense-bed: 2000)")
@@ -537,6 +547,12 @@ int main(int argc, char** argv)
     scene->add_option("--gap", sa.gap, "drop: initial gap between the sphere and the wall (m)")->check(number_from(0.0, false));
     scene->add_option("--from", sa.from, "compression: the scene that was settled");
     scene->add_option("--state", sa.state, "compression: the settled state file");
+    scene->add_option("--test", sa.chung_ooi.test, "chung-ooi: the test, 1 to 8 (docs/validation.md)")->check(integer_in(1, 8));
+    scene->add_option("--material", sa.chung_ooi.material, "chung-ooi: the test's material (default its first)");
+    scene->add_option("--value", sa.chung_ooi.value, "chung-ooi: the swept value (e, angle in degrees, tangential speed or spin; default the first)")
+        ->each([&sa](const std::string&) { sa.chung_ooi_value = true; });
+    scene->add_option("--law", sa.chung_ooi.law, "chung-ooi: paper | restitution | linear_history | mindlin");
+    scene->add_option("--per-tc", sa.chung_ooi.per_tc, "chung-ooi: Δt = t_c / this (default 200)")->check(number_from(1.0, false));
     scene->add_option("--contact", sa.contact, "KEY=VALUE of the [contact] table, repeatable (e.g. tangential=mindlin); docs/scene-format.md");
 
     RunArgs ra;

@@ -78,7 +78,8 @@ MemoryParams<double> memory_params(const Scene& scene)
     if (m.damping == NormalDamping::tsuji) q.alpha = tsuji_alpha(m.restitution);
     if (m.damping == NormalDamping::restitution) q.alpha = restitution_alpha(m.restitution);
     // Mindlin's 1/G* = 2(2−ν_i)(1+ν_i)/E_i + 2(2−ν_j)(1+ν_j)/E_j, from E and ν only (not the scene's `shear`).
-    auto shear_term = [](const Material& x) { return 2.0 * (2.0 - x.poisson) * (1.0 + x.poisson) / x.young; };
+    // A rigid wall adds nothing to 1/G* (physics.md §9).
+    auto shear_term = [](const Material& x) { return x.rigid ? 0.0 : 2.0 * (2.0 - x.poisson) * (1.0 + x.poisson) / x.young; };
     q.shear8_pp = 8.0 / (shear_term(scene.material) + shear_term(scene.material));
     q.shear8_pw = 8.0 / (shear_term(scene.material) + shear_term(scene.wall_mat()));
     q.mindlin = m.tangential == TangentialModel::mindlin;

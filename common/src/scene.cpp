@@ -106,6 +106,13 @@ public:
             fail(fmt::format("'{}' = {} is out of range ({} to {})", qualified(key), printable(text), lo, hi));
         return v;
     }
+    bool boolean(const std::string& key, bool fallback)
+    {
+        if (!has(key)) return fallback;
+        const auto& x = raw(key);
+        if (!x.is_boolean()) fail(fmt::format("'{}' must be true or false", qualified(key)));
+        return x.as_boolean();
+    }
     std::string string(const std::string& key, const std::string& fallback)
     {
         if (!has(key)) return fallback;
@@ -159,7 +166,7 @@ private:
     bool closed_ = false;
 };
 
-Material read_material(Table t)
+Material read_material_keys(Table& t)
 {
     Material m;
     m.density = t.positive("density", m.density);
@@ -170,6 +177,22 @@ Material read_material(Table t)
     m.gamma_n = t.non_negative("gamma_n", m.gamma_n);
     m.gamma_t = t.non_negative("gamma_t", m.gamma_t);
     m.mu = t.non_negative("mu", m.mu);
+    return m;
+}
+
+Material read_material(Table t) { return read_material_keys(t); }
+
+// [wall_material]: a material, or `rigid = true` alone (a rigid wall has no elastic constants to give).
+Material read_wall_material(Table t)
+{
+    if (!t.boolean("rigid", false)) return read_material_keys(t);
+    for (const char* key : {"density", "young", "poisson", "shear", "gamma_n", "gamma_t", "mu"})
+        if (t.has(key))
+            t.fail(fmt::format("'{}' has no meaning for a rigid wall (rigid = true: it adds nothing to E* and G*; damping and "
+                               "friction are the particles')",
+                               t.qualified(key)));
+    Material m;
+    m.rigid = true;
     return m;
 }
 
@@ -259,7 +282,9 @@ ContactParams<double> Scene::contact_params() const
     const Material& p = material;
     const Material& w = wall_mat();
     const double e_pp = 1.0 / ((1.0 - p.poisson * p.poisson) / p.young + (1.0 - p.poisson * p.poisson) / p.young);
-    const double e_pw = 1.0 / ((1.0 - p.poisson * p.poisson) / p.young + (1.0 - w.poisson * w.poisson) / w.young);
+    // A rigid wall adds nothing to 1/E* (physics.md §9); a wall of a material, its (1 − ν²)/E.
+    const double wall_term = w.rigid ? 0.0 : (1.0 - w.poisson * w.poisson) / w.young;
+    const double e_pw = 1.0 / ((1.0 - p.poisson * p.poisson) / p.young + wall_term);
     ContactParams<double> c;
     c.hertz_pp = 4.0 / 3.0 * e_pp;
     c.hertz_pw = 4.0 / 3.0 * e_pw;
@@ -280,6 +305,7 @@ std::uint64_t Scene::fingerprint(std::size_t particle_count) const
     auto mixd = [&](double d) { mix(&d, sizeof d); };
     for (const Material* m : {&material, &wall_mat()})
         for (double d : {m->density, m->young, m->poisson, m->gamma_n, m->gamma_t, m->mu}) mixd(d);
+    if (wall_mat().rigid) mixd(-1.0);  // only a scene with a rigid wall mixes this in: every other fingerprint stays
     for (double d : contact_model.fingerprint_values()) mixd(d);  // none for the paper's law
     mixd(dt);
     mixd(gravity.x); mixd(gravity.y); mixd(gravity.z);
@@ -307,7 +333,7 @@ Scene parse_scene(const std::string& text, const std::string& label)
     Table top(root, "", label);
     s.name = top.string("name", "unnamed");
     s.material = top.has("material") ? read_material(top.table("material")) : Material{};
-    if (top.has("wall_material")) s.wall_material = read_material(top.table("wall_material"));
+    if (top.has("wall_material")) s.wall_material = read_wall_material(top.table("wall_material"));
 
     {
         Table t = top.table("time");
@@ -464,7 +490,7 @@ std::string scene_to_toml(const Scene& s)
     std::string o;
     o += fmt::format("# DEMMAT scene (format: docs/scene-format.md)\nname = {}\n\n", quoted(s.name));
     o += "[material]\n" + material_toml(s.material) + "\n";
-    if (s.wall_material) o += "[wall_material]\n" + material_toml(*s.wall_material) + "\n";
+    if (s.wall_material) o += "[wall_material]\n" + (s.wall_material->rigid ? std::string("rigid = true\n") : material_toml(*s.wall_material)) + "\n";
     o += fmt::format("[time]\ndt = {}\ngravity = {}\n\n", num(s.dt), vec3(s.gravity));
     o += fmt::format("[domain]\nmin = {}\nmax = {}\n\n", vec3(s.domain.min), vec3(s.domain.max));
     for (const Wall& w : s.walls) {

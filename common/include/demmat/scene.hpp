@@ -22,6 +22,9 @@ struct Material {
     double gamma_n = 60.0;    // 1/s
     double gamma_t = 60.0;    // 1/s
     double mu = 0.6;
+    // A wall only: infinitely stiff (LAMMPS's `rigid`), so it adds nothing to E* and G* (physics.md §9);
+    // its other constants are unused. Written as `[wall_material] rigid = true` (docs/scene-format.md).
+    bool rigid = false;
 
     double shear_modulus() const { return shear > 0.0 ? shear : young / (2.0 * (1.0 + poisson)); }
 };
