@@ -153,7 +153,7 @@ State run_lammps(const Scene& scene, const State& s, std::int64_t steps, const s
 
 Snapshot run_suite(const Scene& scene, std::int64_t steps)
 {
-    test::Problem c(scene);
+    const Problem c(scene);
     test::VariantRun run("arrays", c.setup());
     run.driver->run(steps);
     return run.snapshot();
