@@ -11,6 +11,7 @@ One loader for every schema, so that no script parses a result file of its own:
   demmat_stability JSON (bench/stability_study.cpp)                                 kind "stability"
   demmat_accuracy JSON + the CSV beside it (bench/accuracy_study.cpp)                kind "accuracy"
   callgrind_<v>.json (analysis/callgrind_phases.py)                                  kind "callgrind"
+  demmat_validation validation.json + the test<K>.csv beside it (bench/validation_study.cpp) kind "validation"
 
 Timing tables are tidy: one row per (sample, phase) with the columns variant, threads, N, phase,
 repetition, seconds (per step), sample (the id of the timed run the row belongs to), and whatever else
@@ -97,6 +98,12 @@ def load(path):
         table = pd.read_csv(csv) if os.path.exists(csv) else pd.DataFrame(raw["rows"])
         return Result("accuracy", path, normalise_provenance(raw["provenance"]), table,
                       {k: v for k, v in raw.items() if k not in ("rows", "provenance")})
+    if "chung_ooi" in raw and "files" in raw:
+        folder = os.path.dirname(path)
+        runs = [pd.read_csv(os.path.join(folder, f)) for f in raw["files"] if not f.endswith("_curves.csv")]
+        meta = {k: v for k, v in raw.items() if k != "provenance"}
+        meta["curves"] = {f: pd.read_csv(os.path.join(folder, f)) for f in raw["files"] if f.endswith("_curves.csv")}
+        return Result("validation", path, normalise_provenance(raw["provenance"]), pd.concat(runs, ignore_index=True), meta)
     if "instructions_per_particle_step" in raw:
         ip = raw["instructions_per_particle_step"]
         table = pd.DataFrame({"variant": raw["variant"], "N": raw["particles"], "phase": list(ip),
