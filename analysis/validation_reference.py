@@ -241,6 +241,9 @@ def integrate(case, per_tc=4000, keep=False):
 
     t, peak_h, peak_f, touched = 0.0, 0.0, 0.0, False
     samples = []
+    # The energy a held stretch gains or loses when its stiffness changes (mindlin's k_t = 8G*a follows the
+    # overlap; the stretch is not rescaled): the integral of |xi|^2/2 dk_t over the contact.
+    stiffness_work, kt_prev = 0.0, 0.0
     for _ in range(100 * per_tc):
         k1 = rhs(y)
         k2 = rhs([a + 0.5 * dt * b for a, b in zip(y, k1)])
@@ -256,6 +259,9 @@ def integrate(case, per_tc=4000, keep=False):
         touched = True
         _, _, _, _, fn, h, _, n, cap, kt = c
         samples.append((t, h, fn))
+        if history:
+            stiffness_work += 0.5 * (y[10] ** 2 + y[11] ** 2) * (kt - kt_prev)
+            kt_prev = kt
         if history:  # the stretch kept in the tangent plane (length kept) and at the Coulomb cap
             xn = y[10] * n[0] + y[11] * n[1]
             px, pz = y[10] - xn * n[0], y[11] - xn * n[1]
@@ -273,6 +279,7 @@ def integrate(case, per_tc=4000, keep=False):
         h_end, hd_end = r1 + r2 - d, -((y[7] - y[2]) * dx + (y[8] - y[3]) * dz) / d
     res = outcome(case, [y[2], y[3]], y[4], [y[7], y[8]], y[9], -hd_end)
     res["contact_time"] = t - h_end / hd_end
+    res["stiffness_work"] = stiffness_work
     peak_h, peak_f = _peak([s[1] for s in samples]), _peak([s[2] for s in samples])
     res.update(peak_overlap=peak_h, peak_force=peak_f)
     if keep:
