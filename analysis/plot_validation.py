@@ -105,7 +105,7 @@ def judge(d, refs):
         return diff / r.scale if r.scale > 0 else diff
     e["error"] = e.apply(err, axis=1)
     e["pass"] = [("info" if k in ("info", "scale-info") else
-                  ("differs (no tangential spring)" if k == "expected" else ("pass" if er <= t else "FAIL")))
+                  (("differs (no tangential spring)" if er > t else "agrees") if k == "expected" else ("pass" if er <= t else "FAIL")))
                  for k, er, t in zip(e.kind, e.error, e.tol)]
     return e
 

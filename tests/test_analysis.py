@@ -132,5 +132,42 @@ class Report(unittest.TestCase):
             shutil.rmtree(root)
 
 
+class ValidationReference(unittest.TestCase):
+    """The Chung & Ooi references (analysis/validation_reference.py) against what they must reproduce."""
+
+    def row(self, **kw):
+        r = dict(test=1, law="paper", radius1=0.01, radius2=0.01, density=2800, young=4.8e10, poisson=0.2, mu=0.0,
+                 restitution=1.0, value=0.0)
+        r.update(kw)
+        return r
+
+    def test_integration_of_the_elastic_law_is_hertz(self):
+        import validation_reference as vr
+        c = vr.Case(self.row())
+        r = vr.integrate(c, 2000)
+        h, f, tc = vr.hertz(c.mstar, c.rstar, c.estar, c.vn)
+        self.assertAlmostEqual(r["contact_time"] / tc, 1.0, delta=1e-6)
+        self.assertAlmostEqual(r["peak_force"] / f, 1.0, delta=1e-6)
+        self.assertAlmostEqual(r["normal_restitution"], 1.0, delta=1e-6)
+
+    def test_damping_solved_for_e_rebounds_at_e(self):
+        import validation_reference as vr
+        for law in ("paper", "restitution"):
+            c = vr.Case(self.row(test=3, law=law, radius2=0.0, radius1=0.0025, density=4000, young=3.8e11, poisson=0.23,
+                                 restitution=0.5, value=0.5))
+            self.assertAlmostEqual(vr.integrate(c, 2000)["normal_restitution"], 0.5, delta=1e-3)
+
+    def test_gross_slip_at_a_grazing_angle(self):
+        import validation_reference as vr
+        for law in ("paper", "mindlin"):
+            c = vr.Case(self.row(test=4, law=law, radius2=0.0, radius1=0.0025, density=4000, young=3.8e11, poisson=0.23,
+                                 mu=0.092, restitution=0.98, value=60.0))
+            gross, _, is_gross = vr.limits(c)
+            self.assertTrue(is_gross)
+            r = vr.integrate(c, 2000)
+            self.assertAlmostEqual(r["spin"] / gross["spin"], 1.0, delta=1e-2)
+            self.assertAlmostEqual(r["tangential_velocity"] / gross["tangential_velocity"], 1.0, delta=1e-2)
+
+
 if __name__ == "__main__":
     unittest.main()
