@@ -91,8 +91,9 @@ def write_bench(df, provenance, versions, out, figure):
     order = sorted(range(len(labels)), key=lambda k: variant_key(labels[k].lower()))
     legend_outside(axes[-1], [handles[k] for k in order], [labels[k] for k in order])
     cpu = (provenance or {}).get("cpu", "")
-    fig.suptitle(f"One core each: the suite's variants, LAMMPS {versions.get('lammps', '')}, "
-                 f"LIGGGHTS {versions.get('liggghts', '')} ({cpu})", fontsize=10)
+    peers = f"LAMMPS {versions.get('lammps', '')}" + (f", LIGGGHTS {versions['liggghts']}" if versions.get("liggghts") else "")
+    law = versions.get("contact_law", "")
+    fig.suptitle(f"One core each: the suite's variants, {peers} ({cpu})" + (f"\ncontact law: {law}" if law else ""), fontsize=10)
     save_figure(fig, figure, footer(provenance or {}, f"median of {int(med.repetitions.max())} interleaved repetitions, one core per code"),
                 dpi=110)
 
@@ -103,7 +104,8 @@ def write_bench(df, provenance, versions, out, figure):
              f"LAMMPS {versions.get('lammps', '?')} (Debian {versions.get('lammps_package', '?')}), "
              f"LIGGGHTS {versions.get('liggghts', '?')} (Debian {versions.get('liggghts_package', '?')}); "
              f"suite commit {(provenance or {}).get('commit', '?')}, {(provenance or {}).get('compiler', '?')}, "
-             f"CPU {cpu}. Ratio < 1: faster than LAMMPS. Produced by scripts/run_peers.sh; every sample in bench_peers.json.", ""]
+             f"CPU {cpu}. Ratio < 1: faster than LAMMPS. Produced by scripts/run_peers.sh; every sample in bench_peers.json.", "",
+             f"Contact law: {versions.get('contact_law', 'the paper' + chr(39) + 's (physics.md section 2)')}.", ""]
     ns = sorted(med.particles.unique())
     for stage in STAGES:
         m = med[med.stage == stage]

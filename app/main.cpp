@@ -498,15 +498,18 @@ int cmd_scene(const SceneArgs& a)
     else if (a.kind == "compression") {
         if (a.from.empty() || a.state.empty()) throw Error("scene compression needs --from SCENE and --state STATE");
         s = compression_scene(load_scene(a.from), a.state, a.speed > 0.0 ? a.speed : 0.5);
+    } else if (a.kind == "settled") {
+        if (a.from.empty() || a.state.empty()) throw Error("scene settled needs --from SCENE and --state STATE");
+        s = settled_scene(load_scene(a.from), a.state);
     } else {
-        throw Error(fmt::format("unknown scene kind '{}' (expected paper, dense-bed, compression, head-on, drop or chung-ooi)", a.kind));
+        throw Error(fmt::format("unknown scene kind '{}' (expected paper, dense-bed, settled, compression, head-on, drop or chung-ooi)", a.kind));
     }
     if (!a.contact.empty()) s.contact_model = contact_model_from_options(a.contact);
     {
         const State state = initial_state(s);
         check_time_step(s, state);  // throws above the stability limit; its warnings are run's to give
     }
-    if (a.kind == "compression" && !a.out.empty()) {  // the state path relative to the new scene file, so the pair can move together
+    if ((a.kind == "compression" || a.kind == "settled") && !a.out.empty()) {  // the state path relative to the new scene file, so the pair can move together
         std::error_code ec;
         const fs::path rel = fs::relative(fs::absolute(a.state), fs::absolute(fs::path(a.out)).parent_path(), ec);
         if (!ec && !rel.empty()) s.state_file = rel;
@@ -535,7 +538,7 @@ int main(int argc, char** argv)
 
     SceneArgs sa;
     auto* scene = app.add_subcommand("scene", "Write a standard scene as an editable TOML file (to stdout without --out)");
-    scene->add_option("kind", sa.kind, "paper | dense-bed | compression | head-on | drop | chung-ooi")->required();
+    scene->add_option("kind", sa.kind, "paper | dense-bed | settled | compression | head-on | drop | chung-ooi")->required();
     scene->add_option("--out,-o", sa.out, "Output file");
     constexpr std::int64_t int_max = 2147483647, int64_max = std::numeric_limits<std::int64_t>::max();
     scene->add_option("--n", sa.count, "Number of particles (paper: 1000, dense-bed: 2000)")
@@ -545,8 +548,8 @@ int main(int argc, char** argv)
         ->check(integer_in(1, int_max));
     scene->add_option("--speed", sa.speed, "head-on: relative speed (m/s); compression: wall speed (m/s)")->check(number_from(0.0, true));
     scene->add_option("--gap", sa.gap, "drop: initial gap between the sphere and the wall (m)")->check(number_from(0.0, false));
-    scene->add_option("--from", sa.from, "compression: the scene that was settled");
-    scene->add_option("--state", sa.state, "compression: the settled state file");
+    scene->add_option("--from", sa.from, "settled, compression: the scene that was settled");
+    scene->add_option("--state", sa.state, "settled, compression: the settled state file");
     scene->add_option("--test", sa.chung_ooi.test, "chung-ooi: the test, 1 to 8 (docs/validation.md)")->check(integer_in(1, 8));
     scene->add_option("--material", sa.chung_ooi.material, "chung-ooi: the test's material (default its first)");
     scene->add_option("--value", sa.chung_ooi.value, "chung-ooi: the swept value (e, angle in degrees, tangential speed or spin; default the first)")

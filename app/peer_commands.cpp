@@ -105,6 +105,7 @@ int cmd_export(const std::string& scene_file, const std::string& state_file, con
     write_atomically(dir / (data.stem().string() + ".lammps"), e.lammps);
     if (!e.liggghts.empty()) write_atomically(dir / (data.stem().string() + ".liggghts"), e.liggghts);
     else std::cerr << "demmat: warning: no LIGGGHTS fragment: " << e.note << "\n";
+    if (!e.warning.empty()) std::cerr << "demmat: warning: " << e.warning << "\n";
     write_atomically(data, e.data);
     return 0;
 }

@@ -51,8 +51,8 @@ for n in $sizes; do
     $demmat run "$bed" --variant fast --time "$settle" --save "$state" -q --json results/fast/settle_${n}.json
   fi
   [[ $settle_only == 1 ]] && continue
-  # The settled bed continuing from its state, walls at rest (a compression stage of speed 0).
-  [[ -f "$settled" ]] || $demmat scene compression --from "$bed" --state "$state" --speed 0 -o "$settled"
+  # The settled bed continuing from its state, walls at rest (demmat scene settled).
+  [[ -f "$settled" ]] || $demmat scene settled --from "$bed" --state "$state" -o "$settled"
   steps=$(( 5000000 / n )); (( steps < 20 )) && steps=20
   # Every thread count in one run, interleaved with the variants, so that the speed-up compares samples
   # taken side by side (separate runs met different moods of the shared machine).

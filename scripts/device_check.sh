@@ -162,7 +162,7 @@ for n in $sizes; do
   "${demmat[@]}" scene dense-bed --n "$n" -o "$work/bed_$n.toml"
   run_capped 200 "${demmat[@]}" run "$work/bed_$n.toml" --variant "$gpu" --time "$settle_time" --save "$work/bed_${n}_settled.state" -q \
     --json "$res/settle_$n.json" >> "$log" 2>&1 || continue
-  "${demmat[@]}" scene compression --from "$work/bed_$n.toml" --state "$work/bed_${n}_settled.state" --speed 0 -o "$work/bed_${n}_settled.toml"
+  "${demmat[@]}" scene settled --from "$work/bed_$n.toml" --state "$work/bed_${n}_settled.state" -o "$work/bed_${n}_settled.toml"
   steps=$((2000000 / n)); ((steps < 3)) && steps=3; ((steps > 200)) && steps=200
   bench "settled_$n" "$work/bed_${n}_settled.toml" "$steps" 3 150
 done

@@ -9,19 +9,23 @@
 #     kinetic energy and bed height while settling, the wall force while compressing; results/peers/physics_*.
 # Usage: scripts/run_peers.sh [--full] [--n "1000 2000"] [--steps K] [--repetitions R] [--variants LIST]
 #                             [--members M] [--physics-n N] [--bench-only] [--physics-only] [--prepare-only]
-#                             [--out DIR] [--build-dir DIR]
+#                             [--contact "KEY=VALUE ..."] [--out DIR] [--build-dir DIR]
 #   default          N = 1000, 2000, 4000; 200 steps; 3 repetitions; every variant; 4 ensemble members
 #   --full           N = 1000 … 64000 (doubling), 500 steps, 5 repetitions, 8 ensemble members (the lead's run)
 #   --n LIST         the sizes N of the benchmark;  --physics-n N: the size of the physics cross-check (2000)
 #   --bench-only, --physics-only   one of the two parts
 #   --prepare-only   settle and export the stages of every N (the slow part, done once), then stop
+#   --contact LIST   every stage with this contact law of physics.md §9 (the [contact] keys, as for
+#                    `demmat scene --contact`), e.g. "tangential=mindlin tangential_damping_ratio=0.5";
+#                    the bed settled with the law, every code with the law from the same particles
+#                    (LAMMPS's pair_style granular keywords, docs/peers.md); LIGGGHTS is left out
 #   --out DIR        results and figures in DIR instead of results/peers and results/figures (a second,
 #                    focused run beside the full one)
 #   --build-dir DIR  the build folder (default build, or $DEMMAT_BUILD_DIR); the peers' work files go
 #                    in DIR/peers
 source "$(dirname "$0")/lib.sh"
 ns="1000 2000 4000"; steps=200; reps=3; variants=all; members=4; phys_n=2000; warmup=20
-do_bench=1; do_phys=1; prepare_only=0; out=results/peers; figures=results/figures
+do_bench=1; do_phys=1; prepare_only=0; out=results/peers; figures=results/figures; contact=""
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --full) ns="1000 2000 4000 8000 16000 32000 64000"; steps=500; reps=5; members=8; shift ;;
@@ -35,6 +39,7 @@ while [[ $# -gt 0 ]]; do
     --physics-only) do_bench=0; shift ;;
     --prepare-only) prepare_only=1; shift ;;
     --out) need_value "$@"; out=$2; figures=$2; shift 2 ;;
+    --contact) need_value "$@"; contact=$2; shift 2 ;;
     *) shared_option "$@"; shift "$SHIFT" ;;
   esac
 done
@@ -47,6 +52,17 @@ cmake_build -q "$BUILD_DIR" demmat
 demmat=$(demmat_in "$BUILD_DIR")
 lmp=$(command -v lmp || true)
 liggghts=$(command -v liggghts || true)
+# A contact law: its stages live in a folder of their own beside the paper's (law_<keys>), its scene
+# options are checked now (a scene of one grain), before any settling.
+contact_args=(); law_dir=""
+if [[ -n $contact ]]; then
+  for kv in $contact; do contact_args+=(--contact "$kv"); done
+  law_dir=law_$(tr -c 'A-Za-z0-9=._\n-' '_' <<<"$contact" | tr ' =' '_-' | head -c 120)
+  check=$(mktemp -d)
+  $demmat scene drop "${contact_args[@]}" -o "$check/law.toml" >/dev/null || { rm -rf "$check"; exit 2; }
+  rm -rf "$check"
+  liggghts=""  # LIGGGHTS's history models take other parameters: the export writes no fragment for a §9 law
+fi
 [[ -n "$lmp" ]] || { echo "run_peers.sh: LAMMPS (lmp) is not installed; scripts/install_deps.sh --optional installs it" >&2; exit 1; }
 export OMP_NUM_THREADS=1   # one core for every code; no mpirun
 work=${demmat%/app/demmat}/peers  # scenes, states, data files and raw outputs (large, not kept in the repository)
@@ -61,6 +77,7 @@ mkdir -p "$work" "$out"
     echo "  \"liggghts\": \"$($liggghts -h 2>&1 | sed -n 's/^LIGGGHTS (Version \([^,]*\),.*/\1/p' | head -1)\","
     echo "  \"liggghts_package\": \"$(dpkg-query -W -f='${Version}' liggghts 2>/dev/null)\","
   fi
+  echo "  \"contact_law\": \"${contact:-paper (physics.md section 2)}\","
   echo "  \"mpi\": \"none (serial runs, OMP_NUM_THREADS=1)\""
   echo "}"
 } > "$work/versions.json"
@@ -68,11 +85,14 @@ mkdir -p "$work" "$out"
 # The three stages for N particles: loose grid (t = 0), settled bed (0.4 s, all walls fixed) and the
 # compression stage (x_max moving in at 0.5 m/s), each exported for the peers.
 settler=arrays; grep -q "^fast " <<<"$($demmat list)" && settler=fast
+# The folder of N's stages: n<N> for the paper's law, n<N>_law_<keys> for a §9 law (settled with that law:
+# a state belongs to its scene's law, physics.md §9).
+stage_dir() { echo "$work/n$1${law_dir:+_$law_dir}"; }
 prepare() {
-  local n=$1 d=$work/n$1
+  local n=$1 d; d=$(stage_dir "$1")
   mkdir -p "$d"
   # Everything kept here derives from the bed: a bed the generator no longer makes is dropped, with all of it.
-  $demmat scene dense-bed --n "$n" -o "$d/loose.toml.new"
+  $demmat scene dense-bed --n "$n" "${contact_args[@]}" -o "$d/loose.toml.new"
   if ! cmp -s "$d/loose.toml.new" "$d/loose.toml"; then
     find "$d" -mindepth 1 ! -name loose.toml.new -delete
     mv "$d/loose.toml.new" "$d/loose.toml"
@@ -81,11 +101,19 @@ prepare() {
   if [[ ! -f $d/settled.state ]]; then
     echo "== settling the dense bed of $n particles (0.4 s simulated, once; kept in $d)"
     # fast on every core where it is built: bit-identical to arrays, so the same settled state, sooner.
-    $demmat run "$d/loose.toml" --variant "$settler" --threads "$JOBS" --time 0.4 --save "$d/settled.state" --quiet >/dev/null
+    # A variant that does not run the scene's law refuses at once (exit 2): arrays, which runs every law, then.
+    local rc=0
+    $demmat run "$d/loose.toml" --variant "$settler" --threads "$JOBS" --time 0.4 --save "$d/settled.state" --quiet >/dev/null 2>&1 || rc=$?
+    if [[ $rc == 2 && $settler != arrays ]]; then
+      $demmat run "$d/loose.toml" --variant arrays --time 0.4 --save "$d/settled.state" --quiet >/dev/null
+    elif [[ $rc != 0 ]]; then
+      $demmat run "$d/loose.toml" --variant "$settler" --threads "$JOBS" --time 0.4 --save "$d/settled.state" --quiet >/dev/null
+    fi
   fi
   [[ -f $d/compression.toml ]] || $demmat scene compression --from "$d/loose.toml" --state "$d/settled.state" -o "$d/compression.toml"
-  [[ -f $d/bed.toml ]] || $demmat scene compression --from "$d/loose.toml" --state "$d/settled.state" --speed 0 -o "$d/bed.toml"
+  [[ -f $d/bed.toml ]] || $demmat scene settled --from "$d/loose.toml" --state "$d/settled.state" -o "$d/bed.toml"
   for stage in loose bed compression; do
+    # A law's settled state holds stretches, which a data file cannot (export warns on stderr).
     [[ -f $d/$stage.data ]] || $demmat export-lammps "$d/$stage.toml" -o "$d/$stage.data"
   done
 }
@@ -107,7 +135,7 @@ if [[ $do_bench == 1 ]]; then
   codes=(suite lammps); [[ -n "$liggghts" ]] && codes+=(liggghts)
   for ((r = 0; r < reps; r++)); do
     for n in $ns; do
-      d=$work/n$n
+      d=$(stage_dir "$n")
       for stage in loose bed compression; do
         for ((q = 0; q < ${#codes[@]}; q++)); do
           code=${codes[$(((q + r) % ${#codes[@]}))]}   # rotated each repetition: drift hits all alike
@@ -134,7 +162,7 @@ if [[ $do_bench == 1 ]]; then
 fi
 
 if [[ $do_phys == 1 ]]; then
-  n=$phys_n; prepare "$n"; d=$work/n$n; p=$work/physics_n$n
+  n=$phys_n; prepare "$n"; d=$(stage_dir "$n"); p=$work/physics_n$n${law_dir:+_$law_dir}
   mkdir -p "$p"; rm -f "$p"/*.csv
   settle_steps=30000; settle_every=1000; comp_steps=6000; comp_every=300; amplitude=1e-6
   echo "== physics cross-check: $members perturbed starts per code, $n particles"

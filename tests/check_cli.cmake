@@ -29,6 +29,13 @@ foreach(key commit compiler flags cpu seconds_per_step contacts)
   endif()
 endforeach()
 run_ok(scene compression --from ${WORK}/bed.toml --state ${WORK}/bed.state -o ${WORK}/comp.toml)
+# The settled bed as a scene of its own: every wall still, the state's particles.
+run_ok(scene settled --from ${WORK}/bed.toml --state ${WORK}/bed.state -o ${WORK}/settled.toml)
+file(READ ${WORK}/settled.toml settled_text)
+if(settled_text MATCHES "velocity = \\[-" OR NOT settled_text MATCHES "bed.state")
+  message(FATAL_ERROR "scene settled: a wall moves, or the state is not named:\n${settled_text}")
+endif()
+run_ok(run ${WORK}/settled.toml --steps 3 -q)
 run_ok(compare ${WORK}/comp.toml --variants all --steps 30)
 # bench at two thread counts in one run: a summary entry per (variant, threads), arrays once (not threaded).
 run_ok(bench ${WORK}/comp.toml --variants arrays,fast --threads 1,2 --steps 3 --warmup 0 --repetitions 2 --json ${WORK}/bench.json)

@@ -10,6 +10,7 @@
 
 #include <fmt/format.h>
 
+#include "demmat/contact_memory.hpp"
 #include "demmat/error.hpp"
 #include "demmat/io.hpp"
 #include "demmat/reference.hpp"
@@ -89,23 +90,84 @@ std::string data_file(const Scene& scene, const State& s)
 
 double e_star_pw(const Scene& scene) { return scene.contact_params().estar_pw(); }
 
+// The e that LAMMPS's `damping tsuji` must be given for the damping constant α: Tsuji's fit α(e) falls
+// monotonically from α(0) = 1.2728 to α(1) ≈ 0, so a `restitution` run's solved α is exported as the e whose
+// fit gives it (bisection to the last bit), and LAMMPS computes the same η_n = α·sqrt(m*·k_n).
+double tsuji_e_for_alpha(double alpha)
+{
+    if (!(alpha <= tsuji_alpha(0.0)))
+        throw Error(fmt::format("export: the restitution damping's alpha = {} exceeds what LAMMPS's damping tsuji can express ({} at e = 0)",
+                                alpha, tsuji_alpha(0.0)));
+    double lo = 0.0, hi = 1.0;
+    for (int k = 0; k < 200 && lo < hi; ++k) {
+        const double mid = 0.5 * (lo + hi);
+        if (mid == lo || mid == hi) break;
+        (tsuji_alpha(mid) > alpha ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+// The contact law in pair_style granular's words (physics.md §9): the damping coefficient that follows
+// hertz/material's modulus, then the damping, tangential and rolling keywords, always with limit_damping
+// (the cap uses the clipped F_n, as here). `mindlin_kt` is the tangential keyword's stiffness for mindlin:
+// NULL for pairs (LAMMPS derives 8·G* from E and ν as physics.md does), the number 8·G* for walls (this
+// LAMMPS version's fix wall/gran derives it wrongly).
+struct LammpsLaw {
+    std::string damping_coefficient, keywords;
+};
+LammpsLaw lammps_law(const Scene& scene, const std::string& mindlin_kt)
+{
+    const Material& m = scene.material;
+    const ContactModel& law = scene.contact_model;
+    LammpsLaw out;
+    if (law.damping == NormalDamping::viscous) {
+        out.damping_coefficient = d17(m.gamma_n);
+        out.keywords = "damping mass_velocity";
+    } else {
+        const double e = law.damping == NormalDamping::tsuji ? law.restitution : tsuji_e_for_alpha(restitution_alpha(law.restitution));
+        out.damping_coefficient = d17(e);
+        out.keywords = "damping tsuji";
+    }
+    switch (law.tangential) {
+    case TangentialModel::viscous:
+        // linear_nohistory's damping is x·η_n: the paper's γ_t·m* only when η_n is the paper's γ_n·m*.
+        if (law.damping != NormalDamping::viscous)
+            throw Error(fmt::format("export: the paper's viscous friction (gamma_t*m*) beside damping {} cannot be written for LAMMPS, "
+                                    "whose tangential linear_nohistory damping scales with the normal damping", name(law.damping)));
+        if (m.gamma_n == 0.0 && m.gamma_t != 0.0)
+            throw Error("export: LAMMPS's tangential linear_nohistory damping is x·γn·m*, so γt != 0 with γn = 0 cannot be expressed");
+        out.keywords += fmt::format(" tangential linear_nohistory {} {}", d17(m.gamma_n == 0.0 ? 0.0 : m.gamma_t / m.gamma_n), d17(m.mu));
+        break;
+    case TangentialModel::linear_history:
+        out.keywords += fmt::format(" tangential linear_history {} {} {}", d17(law.kt), d17(law.tangential_damping_ratio), d17(m.mu));
+        break;
+    case TangentialModel::mindlin:
+        out.keywords += fmt::format(" tangential mindlin {} {} {}", mindlin_kt, d17(law.tangential_damping_ratio), d17(m.mu));
+        break;
+    }
+    if (law.rolling == RollingModel::sds)
+        out.keywords += fmt::format(" rolling sds {} {} {}", d17(law.kr), d17(law.rolling_damping), d17(law.rolling_friction));
+    out.keywords += " limit_damping";
+    return out;
+}
+
 std::string lammps_fragment(const Scene& scene, const State& s, const PeerOptions& o, double skin)
 {
     const Material& m = scene.material;
-    if (m.gamma_n == 0.0 && m.gamma_t != 0.0)
-        throw Error("export: LAMMPS's tangential linear_nohistory damping is x·γn·m*, so γt != 0 with γn = 0 cannot be expressed");
-    const double xgt = m.gamma_n == 0.0 ? 0.0 : m.gamma_t / m.gamma_n;
-    std::string out = fmt::format(
-        "# LAMMPS input fragment from demmat export-lammps: scene '{}' at step {} (docs/peers.md).\n"
-        "# The paper's contact law: Hertz (4/3)E*sqrt(R*)h^1.5 + gamma_n*m*u_n clipped at 0 (limit_damping),\n"
-        "# tangential -min(mu*Fn, gamma_t*m*|u_t|) without history; velocity Verlet (nve/sphere).\n",
-        scene.name, s.step);
+    const LammpsLaw pair_law = lammps_law(scene, "NULL");
+    const LammpsLaw wall_law_words = lammps_law(scene, d17(memory_params(scene).shear8_pw));
+    std::string out = fmt::format("# LAMMPS input fragment from demmat export-lammps: scene '{}' at step {} (docs/peers.md).\n", scene.name, s.step);
+    if (scene.contact_model.is_paper())
+        out += "# The paper's contact law: Hertz (4/3)E*sqrt(R*)h^1.5 + gamma_n*m*u_n clipped at 0 (limit_damping),\n"
+               "# tangential -min(mu*Fn, gamma_t*m*|u_t|) without history; velocity Verlet (nve/sphere).\n";
+    else
+        out += fmt::format("# The contact law of physics.md section 9: {}.\n# Velocity Verlet (nve/sphere); every contact starts with "
+                           "zero stretch (a data file holds none).\n", scene.contact_model.describe());
     out += "units si\natom_style sphere\natom_modify map array\nboundary f f f\nnewton off\ncomm_modify vel yes\n";
     out += fmt::format("read_data {}\nreset_timestep 0\n", o.data_name);
     out += fmt::format("neighbor {} bin\nneigh_modify delay 0 every 1 check yes\n", d17(skin));
-    const std::string law = fmt::format("damping mass_velocity tangential linear_nohistory {} {} limit_damping", d17(xgt), d17(m.mu));
     out += "pair_style granular\n";
-    out += fmt::format("pair_coeff * * hertz/material {} {} {} {}\n", d17(m.young), d17(m.gamma_n), d17(m.poisson), law);
+    out += fmt::format("pair_coeff * * hertz/material {} {} {} {}\n", d17(m.young), pair_law.damping_coefficient, d17(m.poisson), pair_law.keywords);
     out += fmt::format("timestep {}\n", d17(scene.dt));
     const Vec3d& g = scene.gravity;
     const double gabs = std::sqrt(dot(g, g));
@@ -113,7 +175,7 @@ std::string lammps_fragment(const Scene& scene, const State& s, const PeerOption
     // Walls: the modulus argument that gives the suite's E* in this version's fix wall/gran (see header).
     const double nu = m.poisson;
     const std::string wall_law = fmt::format("granular hertz/material {} {} {} {}", d17(lammps_wall_modulus_argument(e_star_pw(scene), nu)),
-                                             d17(m.gamma_n), d17(nu), law);
+                                             wall_law_words.damping_coefficient, d17(nu), wall_law_words.keywords);
     for (const Wall& w : s.walls) {
         const Vec3d p = w.point_at(s.step, scene.dt);
         const int a = axis_of(w.normal);
@@ -173,6 +235,8 @@ std::string wall_stl(const Scene& scene, const State& s, const Wall& w, int a)
 std::string liggghts_fragment(const Scene& scene, const State& s, const PeerOptions& o, double skin,
                               std::vector<std::pair<std::string, std::string>>& meshes)
 {
+    if (!scene.contact_model.is_paper())
+        throw Error(fmt::format("the LIGGGHTS fragment writes the paper's law only, not {}", scene.contact_model.describe()));
     const Material& m = scene.material;
     const ContactParams<double> cp = scene.contact_params();
     // hertz/stiffness: F = k_n·sqrt(R*δ)·δ − γ·m*·sqrt(R*δ)·u_n: k_n = (4/3)E* exactly; γ matches the
@@ -244,10 +308,12 @@ double liggghts_reference_sqrt_rdelta(const Scene& scene, const State& state)
 PeerExport export_peers(const Scene& scene, const State& state, const PeerOptions& options)
 {
     if (state.size() == 0) throw Error("export: the state has no particles");
-    if (!scene.contact_model.is_paper())  // a later change writes the §9 laws; a data file holds no stretches at all
-        throw Error(fmt::format("export: the scene's contact law ({}) is not exported: the LAMMPS fragment writes the paper's law "
-                                "only, and a LAMMPS data file cannot carry the contacts' stretches", scene.contact_model.describe()));
     PeerExport e;
+    // A data file holds particles, not contacts: a state's stretches are not carried (LAMMPS starts every
+    // contact at zero stretch), which export-lammps says; a start without live contacts loses nothing.
+    if (!state.stretches.empty())
+        e.warning = fmt::format("the state's {} contact stretches are not carried: LAMMPS starts every contact with zero stretch",
+                                state.stretches.size());
     const double skin = options.skin > 0.0 ? options.skin : 0.5 * radius_min(state);
     e.data = data_file(scene, state);
     e.lammps = lammps_fragment(scene, state, options, skin);

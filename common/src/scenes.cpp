@@ -60,13 +60,21 @@ Scene dense_bed_scene(std::int64_t count, std::uint64_t seed, std::int64_t max_l
     return s;
 }
 
-Scene compression_scene(const Scene& settled, const std::filesystem::path& state_file, double speed)
+Scene settled_scene(const Scene& settled, const std::filesystem::path& state_file)
 {
     Scene s = settled;
-    s.name = settled.name + "_compression";
+    s.name = settled.name + "_settled";
     s.grid.reset();
     s.particles.clear();
     s.state_file = state_file;
+    for (Wall& w : s.walls) w.velocity = {};
+    return s;
+}
+
+Scene compression_scene(const Scene& settled, const std::filesystem::path& state_file, double speed)
+{
+    Scene s = settled_scene(settled, state_file);
+    s.name = settled.name + "_compression";
     for (Wall& w : s.walls)
         if (w.name == "x_max") w.velocity = {-speed, 0.0, 0.0};
     return s;

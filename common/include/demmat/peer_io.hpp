@@ -19,6 +19,7 @@ struct PeerExport {
     std::string liggghts;                                     // LIGGGHTS 3.8 input fragment (reads the data file)
     std::vector<std::pair<std::string, std::string>> meshes;  // LIGGGHTS STL files: (file name, content)
     std::string note;                                         // why there is no LIGGGHTS fragment, if there is none
+    std::string warning;                                      // what the export could not carry (a state's stretches), if anything
 };
 
 struct PeerOptions {

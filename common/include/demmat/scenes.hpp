@@ -18,6 +18,8 @@ Scene paper_scene(std::int64_t count = 1000, std::uint64_t seed = 1);
 inline constexpr std::int64_t dense_bed_max_layers = 12;  // why 12: scenes.cpp
 Scene dense_bed_scene(std::int64_t count, std::uint64_t seed = 1, std::int64_t max_layers = dense_bed_max_layers);
 
+// A settled state as a scene of its own, every wall still (the benchmarks' settled bed).
+Scene settled_scene(const Scene& settled, const std::filesystem::path& state_file);
 // Stage 2 of the paper's test from a settled state: the x_max wall moves inwards at `speed` m/s.
 Scene compression_scene(const Scene& settled, const std::filesystem::path& state_file, double speed = 0.5);
 
