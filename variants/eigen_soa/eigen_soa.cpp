@@ -17,6 +17,9 @@
 // components at stride N, calls the shared scalar contact law, and scatter-adds into f and t. The
 // neighbour store is CSR (row offsets + partner ids), built by a hashed cell search as in arrays,
 // within fixed capacities (scene.capacity) that stop the run with a CapacityError when exceeded.
+//
+// Under a contact law with memory (physics.md §9) the stretches are Eigen arrays too, in compressed rows
+// beside the neighbour store, keyed by partner id (stretch_rows.hpp).
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -29,6 +32,7 @@
 #include "demmat/features.hpp"
 #include "demmat/linked_cells.hpp"
 #include "demmat/registry.hpp"
+#include "stretch_rows.hpp"
 
 namespace demmat {
 namespace {
@@ -86,6 +90,7 @@ public:
         dt_ = scene.dt;
         gear_ = setup.gear;
         params_ = setup.contact;
+        memory_ = setup.memory;
         g_ = scene.gravity;
         walls_ = s.walls;
         cell_ = setup.cell_size;
@@ -124,6 +129,13 @@ public:
         }
         cells_.reserve(std::size_t(n_));
         pp_ = pw_ = candidates_ = 0;
+        if constexpr (M::memory) {  // the stretches of a §9 law, carried from the state (none at a fresh start)
+            pp_mem_.reset(n_, nl_.cap, M::history, M::rolling);
+            pw_mem_.reset(n_, bl_.cap, M::history, M::rolling);
+            if (!pp_mem_.load(s.stretches, false) || !pw_mem_.load(s.stretches, true))
+                throw CapacityError(fmt::format("the state holds more contacts than capacity.contacts_per_particle = {} or "
+                                                "wall_contacts_per_particle = {} allow", nl_.cap, bl_.cap));
+        }
     }
 
     void predict(std::int64_t step) override
@@ -149,40 +161,8 @@ public:
         pp_ = 0;
         pw_ = 0;
         candidates_ = n_ > 0 ? nl_.offset(n_) : 0;
-        // Pairs in ascending (i, j): for each particle, partners k < p arrive in ascending k from the
-        // earlier rows, then its own row's partners l > p ascending — the canonical order (physics.md §6).
-        for (Eigen::Index i = 0; i < n_; ++i) {
-            const Index begin = nl_.offset(i), end = nl_.offset(i + 1);
-            if (begin == end) continue;
-            const Vec3d xi = get(x_, i), vi = get(v_, i), wi = get(w_, i);
-            const double ri = r_(i), mi = m_(i);
-            for (Index k = begin; k < end; ++k) {
-                const Eigen::Index j = nl_.partner(k);
-                ContactForce<double> c;
-                if (!particle_contact<M>(xi, get(x_, j), vi, get(v_, j), wi, get(w_, j), ri, r_(j), mi, m_(j), params_, mono_pp_, c))
-                    continue;
-                ++pp_;
-                add(f_, i, c.f_i);
-                add(f_, j, -c.f_i);
-                if constexpr (M::rotation) {
-                    add(t_, i, c.t_i);
-                    add(t_, j, c.t_j);
-                }
-            }
-        }
-        if constexpr (M::walls)
-            for (Eigen::Index i = 0; i < n_; ++i) {
-                for (Index k = bl_.offset(i), end = bl_.offset(i + 1); k < end; ++k) {
-                    const auto w = std::size_t(bl_.wall(k));
-                    ContactForce<double> c;
-                    if (!wall_contact<M>(get(x_, i), get(v_, i), get(w_, i), r_(i), m_(i), wp_[w], walls_[w].normal,
-                                         walls_[w].velocity, params_, mono_pw_, c))
-                        continue;
-                    ++pw_;
-                    add(f_, i, c.f_i);
-                    if constexpr (M::rotation) add(t_, i, c.t_i);
-                }
-            }
+        if constexpr (law) law_contacts();
+        else paper_contacts();
         // Newton with gravity, whole columns: a = F/m + g (division, then addition, as acceleration()).
         const double g[3] = {g_.x, g_.y, g_.z};
         for (int c = 0; c < 3; ++c) {
@@ -228,6 +208,12 @@ public:
         for (int q = 0; q < 12; ++q)
             for (Eigen::Index i = 0; i < n_; ++i) (*dst[q])[std::size_t(i)] = get(*src[q], i);
         for (Eigen::Index i = 0; i < n_; ++i) out.radius[std::size_t(i)] = r_(i);
+        out.stretches.clear();
+        if constexpr (M::memory) {
+            pp_mem_.save(out.stretches, false);
+            pw_mem_.save(out.stretches, true);
+            std::sort(out.stretches.begin(), out.stretches.end());  // the canonical order: by particle, pairs, then walls
+        }
     }
 
     ContactCounts counts() const override { return {pp_, pw_, candidates_}; }
@@ -238,11 +224,98 @@ public:
         const auto n = std::size_t(n_);
         return 16 * 3 * n * sizeof(double) + 3 * n * sizeof(double) +
                std::size_t(nl_.offset.size() + nl_.partner.size() + bl_.offset.size() + bl_.wall.size()) * sizeof(Index) +
-               cells_.memory_bytes() +
-               wp_.size() * sizeof(Vec3d);
+               cells_.memory_bytes() + wp_.size() * sizeof(Vec3d) + pp_mem_.memory_bytes() + pw_mem_.memory_bytes();
     }
 
 private:
+    // The paper's law: each pair and wall contact through the shared law, summed as they come.
+    void paper_contacts()
+    {
+        // Pairs in ascending (i, j): for each particle, partners k < p arrive in ascending k from the
+        // earlier rows, then its own row's partners l > p ascending — the canonical order (physics.md §6).
+        for (Eigen::Index i = 0; i < n_; ++i) {
+            const Index begin = nl_.offset(i), end = nl_.offset(i + 1);
+            if (begin == end) continue;
+            const Vec3d xi = get(x_, i), vi = get(v_, i), wi = get(w_, i);
+            const double ri = r_(i), mi = m_(i);
+            for (Index k = begin; k < end; ++k) {
+                const Eigen::Index j = nl_.partner(k);
+                ContactForce<double> c;
+                if (!particle_contact<M>(xi, get(x_, j), vi, get(v_, j), wi, get(w_, j), ri, r_(j), mi, m_(j), params_, mono_pp_, c))
+                    continue;
+                ++pp_;
+                add(f_, i, c.f_i);
+                add(f_, j, -c.f_i);
+                if constexpr (M::rotation) {
+                    add(t_, i, c.t_i);
+                    add(t_, j, c.t_j);
+                }
+            }
+        }
+        if constexpr (M::walls)
+            for (Eigen::Index i = 0; i < n_; ++i) {
+                for (Index k = bl_.offset(i), end = bl_.offset(i + 1); k < end; ++k) {
+                    const auto w = std::size_t(bl_.wall(k));
+                    ContactForce<double> c;
+                    if (!wall_contact<M>(get(x_, i), get(v_, i), get(w_, i), r_(i), m_(i), wp_[w], walls_[w].normal,
+                                         walls_[w].velocity, params_, mono_pw_, c))
+                        continue;
+                    ++pw_;
+                    add(f_, i, c.f_i);
+                    if constexpr (M::rotation) add(t_, i, c.t_i);
+                }
+            }
+    }
+
+
+    // A law of physics.md §9: as paper_contacts, with each live contact's stretches taken from the
+    // previous evaluation by partner and written to this one's rows (a law without memory has none).
+    void law_contacts()
+    {
+        for (Eigen::Index i = 0; i < n_; ++i) {
+            [[maybe_unused]] auto old = pp_mem_.reader(i);
+            if constexpr (M::memory) pp_mem_.begin_row(i);
+            const Vec3d xi = get(x_, i), vi = get(v_, i), wi = get(w_, i);
+            const double ri = r_(i), mi = m_(i);
+            for (Index k = nl_.offset(i), end = nl_.offset(i + 1); k < end; ++k) {
+                const Index j = nl_.partner(k);
+                Stretch<double> s;
+                if constexpr (M::memory) s = old.take(j);
+                ContactForce<double> c;
+                if (!particle_contact_memory<M>(xi, get(x_, j), vi, get(v_, j), wi, get(w_, j), ri, r_(j), mi, m_(j), params_, memory_, s,
+                                                true, c))
+                    continue;
+                ++pp_;
+                if constexpr (M::memory) pp_mem_.put(j, s);
+                add(f_, i, c.f_i);
+                add(f_, j, -c.f_i);
+                add(t_, i, c.t_i);
+                add(t_, j, c.t_j);
+            }
+        }
+        for (Eigen::Index i = 0; i < n_; ++i) {
+            [[maybe_unused]] auto old = pw_mem_.reader(i);
+            if constexpr (M::memory) pw_mem_.begin_row(i);
+            for (Index k = bl_.offset(i), end = bl_.offset(i + 1); k < end; ++k) {
+                const Index w = bl_.wall(k);
+                Stretch<double> s;
+                if constexpr (M::memory) s = old.take(w);
+                ContactForce<double> c;
+                if (!wall_contact_memory<M>(get(x_, i), get(v_, i), get(w_, i), r_(i), m_(i), wp_[std::size_t(w)],
+                                            walls_[std::size_t(w)].normal, walls_[std::size_t(w)].velocity, params_, memory_, s, true, c))
+                    continue;
+                ++pw_;
+                if constexpr (M::memory) pw_mem_.put(w, s);
+                add(f_, i, c.f_i);
+                add(t_, i, c.t_i);
+            }
+        }
+        if constexpr (M::memory) {
+            pp_mem_.finish_evaluation();
+            pw_mem_.finish_evaluation();
+        }
+    }
+
     void place_walls(std::int64_t step)
     {
         for (std::size_t w = 0; w < nw_; ++w) wp_[w] = walls_[w].point_at(step, dt_);
@@ -321,6 +394,8 @@ private:
         if (over_particle >= 0) wall_overflow(over_particle, bl_.cap, nw_);
     }
 
+    static constexpr bool law = M::restitution_damping || M::history || M::rolling;  // a §9 law, not the paper's
+
     Eigen::Index n_ = 0;
     std::size_t nw_ = 0;
     std::int64_t step_ = 0;
@@ -328,6 +403,7 @@ private:
     double cell_ = 0.0;
     GearCoefficients<double> gear_;
     ContactParams<double> params_;
+    MemoryParams<double> memory_;  // the §9 law's constants (zero for the paper's law)
     Coefficients<double> mono_pp_, mono_pw_;  // monodisperse models: the one pair's and wall contact's coefficients
     Vec3d g_;
     std::vector<Wall> walls_;
@@ -340,13 +416,15 @@ private:
     NeighbourCSR nl_;
     WallCSR bl_;
     LinkedCells cells_;
+    eigen_soa::StretchRows pp_mem_, pw_mem_;  // a §9 law with memory: pairs (partners j > i) and wall contacts
     std::int64_t pp_ = 0, pw_ = 0, candidates_ = 0;
 };
 
-// The instantiation a run gets, picked in init(): the smallest model that covers what the scene needs.
+// The instantiation a run gets, picked in init(): the smallest model that covers what the scene needs
+// (with_law_model: the paper's law gets exactly with_model's instantiation).
 std::unique_ptr<Variant> pick_eigen_soa(const Setup& setup)
 {
-    return with_model(model_for(setup), []<class M>() -> std::unique_ptr<Variant> {
+    return with_law_model(model_for(setup), []<class M>() -> std::unique_ptr<Variant> {
         return std::make_unique<EigenSoaVariant<M>>();
     });
 }
@@ -356,7 +434,8 @@ std::unique_ptr<Variant> pick_eigen_soa(const Setup& setup)
 void register_variant_eigen_soa(Registry& r)
 {
     r.add({"eigen_soa", "Eigen structure of arrays, whole-array predictor and corrector",
-           [] { return std::make_unique<DispatchingVariant>(pick_eigen_soa); }});
+           [] { return std::make_unique<DispatchingVariant>(pick_eigen_soa, /*all_integrators=*/false,
+                                                             /*all_laws=*/true); }});
 }
 
 } // namespace demmat
