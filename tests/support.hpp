@@ -2,6 +2,7 @@
 // Shared helpers for the tests: scenes in memory, runs of a variant, and the list of variants.
 #include <cstdint>
 #include <filesystem>
+#include <functional>
 #include <memory>
 #include <utility>
 #include <string>
@@ -64,12 +65,14 @@ inline State settling_bed_state(const Scene& bed)
 }
 
 // The settling bed as a scene that starts from the cached state; with `wall_speed` > 0, the paper's
-// compression stage (the x_max wall moving inwards), re-anchored at the state's step.
-inline Problem bed_case(double wall_speed)
+// compression stage (the x_max wall moving inwards), re-anchored at the state's step. `edit`, if given,
+// changes the scene before the problem is made (a contact law, a search method).
+inline Problem bed_case(double wall_speed, const std::function<void(Scene&)>& edit = {})
 {
     const Scene bed = dense_bed_scene(2000);
     State st = settling_bed_state(bed);
     Scene s = wall_speed > 0 ? compression_scene(bed, "(cached state)", wall_speed) : bed;
+    if (edit) edit(s);
     st.walls = continue_walls(s, st);
     return Problem(s, st);
 }

@@ -11,6 +11,10 @@
 // order is the canonical summation order of physics.md §6, so every mode gives the same sorted lists
 // and a trajectory bit-identical to arrays.
 //
+// Under a contact law with memory (physics.md §9) a node also holds its contact's stretches
+// (node_lists.hpp): a persistent list carries them in the node of a persisting pair, and the list rebuilt
+// every step looks each pair's old node up by partner as it builds the new one.
+//
 // Two compile-time policies of one template give the three registered variants and what each measures:
 //   linked_list_rebuild  Rebuild = true, nodes from new/delete: every step every node of every list is
 //                        deleted and a fresh one new'ed per candidate, the paper's rebuilt list, so it
@@ -20,139 +24,38 @@
 //   linked_list_pool     persistent lists, nodes from blocks allocated up front (doubled when exhausted)
 //                        and recycled through a free list: no allocator calls once warm, so what remains
 //                        of the difference to arrays is pointer chasing.
-#include <algorithm>
-#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <memory>
+#include <type_traits>
 #include <vector>
 
+#include <fmt/format.h>
+
 #include "demmat/column_state.hpp"
+#include "demmat/error.hpp"
 #include "demmat/features.hpp"
 #include "demmat/linked_cells.hpp"
 #include "demmat/registry.hpp"
+#include "node_lists.hpp"
 
 namespace demmat {
+namespace linked_list {
 namespace {
-
-using Index = std::int32_t;
-
-// ---- node allocation policies ----------------------------------------------------------------------
-
-struct Node {
-    Node* next;
-    Index partner;  // particle id j > i, or wall index
-};
-
-// Every node from the general-purpose heap, every dropped node returned to it at once.
-class HeapNodes {
-public:
-    HeapNodes() = default;
-    HeapNodes(const HeapNodes&) = delete;
-    HeapNodes& operator=(const HeapNodes&) = delete;
-
-    void reserve(std::size_t) {}
-    Node* acquire() { return new Node; }
-    void release(Node* n) { delete n; }
-    // Bytes of node storage held for `live` nodes (the heap's own bookkeeping per block not counted).
-    std::size_t bytes(std::size_t live) const { return live * sizeof(Node); }
-};
-
-// Nodes carved from large blocks; a released node goes on an intrusive free list (through its `next`)
-// and is the next one handed out. Blocks are only freed when the pool is destroyed.
-class PoolNodes {
-public:
-    PoolNodes() = default;
-    PoolNodes(const PoolNodes&) = delete;
-    PoolNodes& operator=(const PoolNodes&) = delete;
-
-    void reserve(std::size_t count)
-    {
-        if (count > capacity_) grow(count - capacity_);
-    }
-    Node* acquire()
-    {
-        if (free_ == nullptr) grow(std::max<std::size_t>(capacity_, 1024));  // doubling
-        Node* n = free_;
-        free_ = n->next;
-        return n;
-    }
-    void release(Node* n)
-    {
-        n->next = free_;
-        free_ = n;
-    }
-    std::size_t bytes(std::size_t) const { return capacity_ * sizeof(Node) + blocks_.capacity() * sizeof(blocks_[0]); }
-
-private:
-    void grow(std::size_t count)
-    {
-        blocks_.push_back(std::unique_ptr<Node[]>(new Node[count]));
-        Node* b = blocks_.back().get();
-        for (std::size_t k = count; k-- > 0;) {  // threaded so that a fresh block is handed out in address order
-            b[k].next = free_;
-            free_ = &b[k];
-        }
-        capacity_ += count;
-    }
-
-    std::vector<std::unique_ptr<Node[]>> blocks_;
-    Node* free_ = nullptr;
-    std::size_t capacity_ = 0;
-};
-
-// Makes a sorted list equal to a sorted candidate set given one candidate at a time in ascending order:
-// nodes with a smaller partner than the next candidate are dropped, a node equal to it is kept, and a
-// missing one is linked in at that position; finish() drops what is left after the last candidate.
-template <class Nodes>
-class ListMerge {
-public:
-    ListMerge(Node*& head, Nodes& nodes, std::size_t& live) : link_(&head), nodes_(nodes), live_(live) {}
-
-    void keep(Index c)
-    {
-        Node* cur = *link_;
-        while (cur != nullptr && cur->partner < c) {  // pair left: free its node
-            *link_ = cur->next;
-            nodes_.release(cur);
-            --live_;
-            cur = *link_;
-        }
-        if (cur != nullptr && cur->partner == c) {  // pair persists: keep its node
-            link_ = &cur->next;
-            return;
-        }
-        Node* fresh = nodes_.acquire();  // new pair: a node in sorted position
-        fresh->partner = c;
-        fresh->next = cur;
-        *link_ = fresh;
-        link_ = &fresh->next;
-        ++live_;
-    }
-
-    void finish()
-    {
-        while (Node* cur = *link_) {
-            *link_ = cur->next;
-            nodes_.release(cur);
-            --live_;
-        }
-    }
-
-private:
-    Node** link_;
-    Nodes& nodes_;
-    std::size_t& live_;
-};
 
 // ---- the processor ---------------------------------------------------------------------------------
 
-// Rebuild: empty every list (release all nodes) at the start of each search, so the merge acquires a
-// fresh node for every candidate; otherwise the lists persist from step to step.
-template <class T, class M, class Nodes, bool Rebuild = false>
+// Pool: where nodes come from (HeapNodes, PoolNodes). Rebuild: empty every list at each search, so a
+// fresh node is acquired for every candidate; otherwise the lists persist from step to step.
+template <class T, class M, template <class> class Pool, bool Rebuild = false>
 class LinkedListVariant final : public ColumnStateVariant<T, M> {
     using ColumnStateVariant<T, M>::state_, ColumnStateVariant<T, M>::pp_, ColumnStateVariant<T, M>::pw_,
         ColumnStateVariant<T, M>::candidates_;
+    using Node = linked_list::Node<T, M::memory>;
+    using Nodes = Pool<Node>;
+    // The paper's law frees every list at once before the search; a law with memory rebuilds each list
+    // beside the old one, to carry the stretches over (node_lists.hpp).
+    using Merge = std::conditional_t<Rebuild && M::memory, RebuildMerge<Nodes>, ListMerge<Nodes>>;
 
 public:
     LinkedListVariant() = default;
@@ -176,11 +79,12 @@ public:
         scratch_.reserve(64);
         cells_.reserve(n);
         pp_ = pw_ = candidates_ = 0;
+        if constexpr (M::memory) load_stretches(setup.state->stretches);
     }
 
     void search() override
     {
-        if constexpr (Rebuild) free_lists();
+        if constexpr (Rebuild && !M::memory) free_lists();
         if (cell_ > T(0)) search_cells();
         else search_all_pairs();
         if constexpr (M::walls) search_walls();
@@ -194,14 +98,39 @@ public:
         candidates_ = std::int64_t(pp_live_);
         const std::size_t n = state_.size();
         // Particles in id order, each list in partner order: the canonical order of physics.md §6.
-        for (std::size_t i = 0; i < n; ++i)
-            for (const Node* node = pp_head_[i]; node != nullptr; node = node->next)
-                if (state_.pair(i, std::size_t(node->partner))) ++pp_;
-        if constexpr (M::walls)
+        if constexpr (M::memory) {
             for (std::size_t i = 0; i < n; ++i)
-                for (const Node* node = pw_head_[i]; node != nullptr; node = node->next)
-                    if (state_.wall(i, std::size_t(node->partner))) ++pw_;
+                for (Node* node = pp_head_[i]; node != nullptr; node = node->next)
+                    pp_ += remember(node, state_.pair(i, std::size_t(node->partner), node->stretch));
+            if constexpr (M::walls)
+                for (std::size_t i = 0; i < n; ++i)
+                    for (Node* node = pw_head_[i]; node != nullptr; node = node->next)
+                        pw_ += remember(node, state_.wall(i, std::size_t(node->partner), node->stretch));
+        } else {
+            for (std::size_t i = 0; i < n; ++i)
+                for (const Node* node = pp_head_[i]; node != nullptr; node = node->next)
+                    if (state_.pair(i, std::size_t(node->partner))) ++pp_;
+            if constexpr (M::walls)
+                for (std::size_t i = 0; i < n; ++i)
+                    for (const Node* node = pw_head_[i]; node != nullptr; node = node->next)
+                        if (state_.wall(i, std::size_t(node->partner))) ++pw_;
+        }
         state_.newton();
+    }
+
+    // The state, and under a law with memory every live contact's stretches: particle by particle, its
+    // pair list then its wall list, both ascending, which is the canonical order.
+    void save(State& out) const override
+    {
+        state_.save(out);
+        out.stretches.clear();
+        if constexpr (M::memory)
+            for (std::size_t i = 0; i < state_.size(); ++i)
+                for (bool wall : {false, true})
+                    for (const Node* node = (wall ? pw_head_ : pp_head_)[i]; node != nullptr; node = node->next)
+                        if (node->live)
+                            out.stretches.push_back({std::int64_t(i), std::int64_t(node->partner), wall,
+                                                     cast<double>(node->stretch.t), cast<double>(node->stretch.r)});
     }
 
     std::size_t memory_bytes() const override
@@ -211,10 +140,36 @@ public:
     }
 
 private:
+    // A contact evaluated under a law with memory: a live one has advanced its stretch in place; one that
+    // has opened forgets it (a contact that closes again starts at zero, physics.md §9).
+    static bool remember(Node* node, bool live)
+    {
+        node->live = live;
+        if (!live) node->stretch = {};
+        return live;
+    }
+
+    // The live contacts of a saved state (canonical order: each particle's partners, then walls,
+    // ascending), appended to the lists they belong to; the first search keeps those still candidates.
+    void load_stretches(const std::vector<ContactStretch>& in)
+    {
+        for (const ContactStretch& c : in) {
+            Node** link = &(c.wall ? pw_head_ : pp_head_)[std::size_t(c.i)];
+            while (*link != nullptr) link = &(*link)->next;
+            Node* node = nodes_.acquire();
+            start_contact(node, Index(c.partner));
+            node->live = true;
+            node->stretch = {cast<T>(c.tangential), cast<T>(c.rolling)};
+            node->next = nullptr;
+            *link = node;
+            ++(c.wall ? pw_live_ : pp_live_);
+        }
+    }
+
     // Merges particle i's sorted candidates (in scratch_) into its list.
     void update_pairs(std::size_t i)
     {
-        ListMerge<Nodes> merge(pp_head_[i], nodes_, pp_live_);
+        Merge merge(pp_head_[i], nodes_, pp_live_);
         for (const Index j : scratch_) merge.keep(j);
         merge.finish();
     }
@@ -226,7 +181,7 @@ private:
         const T* x = state_.x();
         const T* r = state_.r();
         for (std::size_t i = 0; i < n; ++i) {
-            ListMerge<Nodes> merge(pp_head_[i], nodes_, pp_live_);
+            Merge merge(pp_head_[i], nodes_, pp_live_);
             const Vec3<T> xi = get(x, n, i);
             for (std::size_t j = i + 1; j < n; ++j)
                 if (may_touch(xi, get(x, n, j), r[i], r[j])) merge.keep(Index(j));
@@ -261,7 +216,7 @@ private:
         const T* x = state_.x();
         const T* r = state_.r();
         for (std::size_t i = 0; i < n; ++i) {
-            ListMerge<Nodes> merge(pw_head_[i], nodes_, pw_live_);
+            Merge merge(pw_head_[i], nodes_, pw_live_);
             const Vec3<T> xi = get(x, n, i);
             for (std::size_t w = 0; w < nw; ++w)
                 if (may_touch_wall(xi, r[i], state_.wall_point(w), state_.wall_normal(w))) merge.keep(Index(w));
@@ -292,22 +247,26 @@ private:
     LinkedCells cells_;
 };
 
-// The instantiation a run gets, picked in init() as in arrays (the same ColumnState, the same models), so
-// that a comparison with arrays keeps isolating the contact store.
-template <class Nodes, bool Rebuild = false>
+// The instantiation a run gets, picked in init() as in arrays (the same ColumnState, the same models, the
+// paper's law exactly with_model's), so that a comparison with arrays keeps isolating the contact store.
+template <template <class> class Pool, bool Rebuild = false>
 std::unique_ptr<Variant> make_dispatching()
 {
-    return std::make_unique<DispatchingVariant>([](const Setup& setup) {
-        return with_model(model_for(setup), []<class M>() -> std::unique_ptr<Variant> {
-            return std::make_unique<LinkedListVariant<double, M, Nodes, Rebuild>>();
-        });
-    });
+    return std::make_unique<DispatchingVariant>(
+        [](const Setup& setup) {
+            return with_law_model(model_for(setup), []<class M>() -> std::unique_ptr<Variant> {
+                return std::make_unique<LinkedListVariant<double, M, Pool, Rebuild>>();
+            });
+        },
+        /*all_integrators=*/false, /*all_laws=*/true);
 }
 
 } // namespace
+} // namespace linked_list
 
 void register_variant_linked_list(Registry& r)
 {
+    using linked_list::HeapNodes, linked_list::PoolNodes, linked_list::make_dispatching;
     r.add({"linked_list", "arrays state; persistent per-particle linked lists of contacts, nodes from new/delete",
            [] { return make_dispatching<HeapNodes>(); }});
     r.add({"linked_list_pool", "arrays state; persistent per-particle linked lists of contacts, nodes from a recycled pool",
