@@ -153,8 +153,8 @@ State run_lammps(const Scene& scene, const State& s, std::int64_t steps, const s
 
 Snapshot run_suite(const Scene& scene, std::int64_t steps)
 {
-    test::Problem c(scene);
-    test::VariantRun run("arrays", c.setup());
+    const Problem p(scene);
+    test::VariantRun run("arrays", p.setup());
     run.driver->run(steps);
     return run.snapshot();
 }
