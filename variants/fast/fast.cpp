@@ -19,7 +19,7 @@ public:
     explicit FastDispatch(const FastOptions& o) : opt_(o) {}
 
     // Every law of physics.md §9 in the canonical order (gear5 in double); fast_unordered the paper's only.
-    bool supports(const ContactModel& law) const override { return law.is_paper(); }
+    bool supports(const ContactModel& law) const override { return opt_.canonical || law.is_paper(); }
 
     void init(const Setup& setup) override
     {
