@@ -126,7 +126,7 @@ private:
     // computed from R and m in the lanes: cheaper than reading them from a per-pair array), and the lanes
     // transposed back into the slots (zeros where h <= 0) or added to the loads.
     template <bool Canonical>
-    int pack(const std::size_t* ks, int count, Load* load, const SlotSink& sink) const
+    [[gnu::flatten]] int pack(const std::size_t* ks, int count, Load* load, const SlotSink& sink) const
     {
         std::size_t k[kLanes], s[kLanes], q[kLanes];
         for (int l = 0; l < kLanes; ++l) {

@@ -282,7 +282,7 @@ private:
     // stored): the records transposed into the lanes, wall_contact_lanes, and back. Each lane's bits are
     // those wall_contact gives.
     template <class M>
-    int pack(const Particles& p, const LawInputs& law, const Candidate* cand, int count, Load* out, Quad* stretches) const
+    [[gnu::flatten]] int pack(const Particles& p, const LawInputs& law, const Candidate* cand, int count, Load* out, Quad* stretches) const
     {
         constexpr bool kLaw = M::restitution_damping || M::history || M::rolling;
         std::size_t s[kLanes], w[kLanes];
