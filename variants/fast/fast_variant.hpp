@@ -144,7 +144,13 @@ public:
         } else {
             throw Error("fast_unordered does not run the contact laws of physics.md §9");  // refused by supports() before
         }
-        fresh_ = false;
+        if (fresh_) {
+            fresh_ = false;
+            if constexpr (kMemory) {
+                stretches_.release_carry();
+                std::vector<ContactStretch>().swap(loaded_);
+            }
+        }
     }
 
     // Deferred to the next predict() (fused with its predictor), or applied by snapshot() and save() to
@@ -224,7 +230,10 @@ private:
                    par_);
         list_.build(p_, cells_, skin_, opt_.canonical, par_);
         if (opt_.canonical) sums_.plan(list_, n);
-        if constexpr (kMemory) stretches_.apply(list_, p_.id, n, par_);
+        if constexpr (kMemory) {
+            stretches_.apply(list_, p_.id, n, par_);
+            if (!fresh_) stretches_.release_carry();  // while fresh, the next rebuild reads the state's again
+        }
         p_.xref = p_.x;
         walls_.begin_listing();
         std::size_t listing_team = 1;

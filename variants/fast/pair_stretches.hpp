@@ -154,6 +154,16 @@ public:
         }
     }
 
+    // The carried stretches are no longer needed once every rebuild that may read them is done (held
+    // only across a rebuild: rebuilds are rare, and the bytes are the live contacts' once more).
+    void release_carry()
+    {
+        std::vector<Index>().swap(carry_start_);
+        std::vector<Index>().swap(carry_partner_);
+        std::vector<Index>().swap(fill_);
+        std::vector<Quad>().swap(carry_rec_);
+    }
+
     // The live pair contacts of the last force pass (h > 0 at the positions it read: the records), as a
     // state holds them.
     void save(const NeighbourList& list, const Particles& p, std::vector<ContactStretch>& out) const
