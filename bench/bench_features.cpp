@@ -19,8 +19,11 @@
 // driver. Run with --benchmark_enable_random_interleaving=true --benchmark_repetitions=R
 // (scripts/run_features.sh) so machine drift hits every configuration alike.
 //
+// Every variant runs on one core (a threaded one, fast, on one thread: the table compares codes, not
+// machines).
+//
 // Own options (before Google Benchmark's): --n=N (2000), --steps=K (300), --states-dir=DIR (states),
-// --variants=a,b (arrays,eigen_soa).
+// --variants=a,b (arrays,eigen_soa,fast).
 #include <cmath>
 #include <cstring>
 #include <filesystem>
@@ -41,6 +44,7 @@
 #include "demmat/problem.hpp"
 #include "demmat/registry.hpp"
 #include "demmat/text.hpp"
+#include "demmat/threads.hpp"
 #include "demmat/scenes.hpp"
 #include "demmat/state.hpp"
 
@@ -54,7 +58,7 @@ struct Options {
     std::int64_t n = 2000;
     std::int64_t steps = 300;
     fs::path states_dir = "states";
-    std::vector<std::string> variants = {"arrays", "eigen_soa"};
+    std::vector<std::string> variants = {"arrays", "eigen_soa", "fast"};
 };
 Options opt;
 
@@ -147,6 +151,7 @@ void run_level(benchmark::State& st, const std::string& variant, const Level& le
 {
     Problem& p = *level.problem;
     p.widen(full ? ModelFeatures::full() : level.widen);
+    set_threads(1);
     auto v = registry().find(variant).create();
     Driver driver(*v, p.setup());
     for (std::int64_t k = 0; k < kWarmup; ++k) driver.step();

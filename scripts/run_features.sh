@@ -2,17 +2,17 @@
 # What each model feature costs per step (issue 10; docs/design.md, "Model features"): builds
 # demmat_bench_features, settles a monodisperse dense bed once (kept in states/), times the six levels
 # (normal force only, + damping, + friction/rotation, + walls, + moving walls, + polydisperse), each with
-# the specialised model and with the full model, for arrays and eigen_soa, in interleaved repetitions,
+# the specialised model and with the full model, for arrays, eigen_soa and fast (one core), in interleaved repetitions,
 # and writes results/features/ (JSON with provenance, Markdown and CSV tables) and a figure in
 # results/figures/. A few minutes on two cores at the default size.
 # Usage: scripts/run_features.sh [--n N] [--steps K] [--repetitions R] [--variants a,b] [--build-dir DIR]
 #   --n N            grains in the bed (default 2000)
 #   --steps K        timed steps per repetition (default 300)
 #   --repetitions R  interleaved repetitions (default 7)
-#   --variants a,b   the variants timed (default arrays,eigen_soa)
+#   --variants a,b   the variants timed (default arrays,eigen_soa,fast)
 #   --build-dir DIR  the build folder (default build, or $DEMMAT_BUILD_DIR)
 source "$(dirname "$0")/lib.sh"
-n=2000; steps=300; reps=7; variants=arrays,eigen_soa
+n=2000; steps=300; reps=7; variants=arrays,eigen_soa,fast
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --n) need_value "$@"; n=$2; shift 2 ;;

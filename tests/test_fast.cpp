@@ -5,6 +5,7 @@
 // (measured: the spread of fast_unordered itself over thread counts).
 #include <array>
 #include <cmath>
+#include <cstring>
 #include <iostream>
 
 #ifdef _OPENMP
@@ -17,62 +18,13 @@
 
 #include "demmat/threads.hpp"
 #include "fast.hpp"
+#include "fast_support.hpp"
 #include "support.hpp"
 
 using namespace demmat;
 using namespace demmat::test;
 
 namespace {
-
-struct FastRun {
-    FastOptions options;
-    int threads;
-};
-
-struct LockstepResult {
-    std::string difference;                // "" when every step of every run was bit-identical to arrays
-    std::vector<std::int64_t> rebuilds;    // per fast run
-    std::int64_t contacts = 0;             // arrays' particle–particle contacts at the end
-};
-
-// arrays and the given fast runs in lockstep, each fast run stepping at its own thread count, compared
-// bit for bit after every step.
-LockstepResult lockstep(const Setup& setup, std::int64_t steps, const std::vector<FastRun>& runs)
-{
-    auto ref = registry().find("arrays").create();
-    Driver ref_driver(*ref, setup);
-    std::vector<std::unique_ptr<FastVariant>> fast;
-    std::vector<std::unique_ptr<Driver>> drivers;
-    for (const FastRun& r : runs) {
-        set_threads(r.threads);
-        FastOptions o = r.options;
-        o.min_parallel = 0;   // the threads asked for, however small the scene
-        o.prefetch_from = 0;  // and the kernel's prefetching path
-        fast.push_back(make_fast_variant(o));
-        drivers.push_back(std::make_unique<Driver>(*fast.back(), setup));
-    }
-    LockstepResult out;
-    Snapshot a, b;
-    for (std::int64_t k = 0; k <= steps && out.difference.empty(); ++k) {
-        if (k > 0) {
-            ref_driver.step();
-            for (std::size_t v = 0; v < runs.size(); ++v) {
-                set_threads(runs[v].threads);
-                drivers[v]->step();
-            }
-        }
-        ref->snapshot(a);
-        for (std::size_t v = 0; v < runs.size() && out.difference.empty(); ++v) {
-            fast[v]->snapshot(b);
-            if (const auto d = first_difference(a, b))
-                out.difference = fmt::format("threads {}, skin {}: {}", runs[v].threads, runs[v].options.skin, d->describe());
-        }
-    }
-    for (const auto& f : fast) out.rebuilds.push_back(f->rebuilds());
-    out.contacts = ref->counts().particle_particle;
-    set_threads(0);
-    return out;
-}
 
 // fast_unordered's options, on the threads asked for and on the prefetching path however small the scene.
 FastOptions threaded_unordered()
@@ -94,26 +46,6 @@ double relative_gap(const std::vector<Vec3d>& a, const std::vector<Vec3d>& b)
             scale = std::max(scale, std::abs(component(a[i], c)));
         }
     return gap / scale;
-}
-
-// Steps `variant` (initialised) `steps` times, each phase on the team `teams[phase][step % size]` (0:
-// predict, 1: search, 2: forces), as OpenMP's dynamic teams may choose; `after` after each step.
-template <class After>
-void step_with_teams(Variant& variant, std::int64_t first_step, std::int64_t steps, const std::array<std::vector<int>, 3>& teams,
-                     After&& after)
-{
-    auto team = [&](int phase, std::int64_t k) { return teams[std::size_t(phase)][std::size_t(k) % teams[std::size_t(phase)].size()]; };
-    for (std::int64_t k = 1; k <= steps; ++k) {
-        set_threads(team(0, k));
-        variant.predict(first_step + k);
-        set_threads(team(1, k));
-        variant.search();
-        set_threads(team(2, k));
-        variant.forces();
-        variant.correct();
-        after(k);
-    }
-    set_threads(0);
 }
 
 } // namespace
@@ -337,4 +269,97 @@ TEST(Fast, ReportsTheThreadsItRunsOn)
 #endif
     set_threads(0);
     EXPECT_EQ(VariantRun("arrays", c.setup()).variant->threads_used(), 1);
+}
+
+// ---- the models fast specialises to (fast_models.hpp) ------------------------------------------------
+
+namespace {
+
+// A monodisperse bed of 500 settled by fast itself (bit-identical to arrays), for the feature levels.
+State settled_mono_bed(const Scene& bed)
+{
+    return settled_state(bed, 12000, "fast_mono_bed_500_12000.state", [] { return make_fast_variant(FastOptions{}); });
+}
+
+} // namespace
+
+TEST(Fast, EachLevelOfTheFeatureChainMatchesTheFullModelWhereItsFeaturesAreInert)
+{
+    // The levels of the cost-per-feature table (bench/bench_features.cpp), each a scene that needs one
+    // feature more than the one before: fast runs the level's model (model() names it) and is
+    // bit-identical at every step, and in the saved Gear state, to the full model (Setup::widen) on the
+    // same scene, where the features the level skips compute zeros.
+    Scene bed = dense_bed_scene(500);
+    bed.grid->radius_min = bed.grid->radius_max;
+    const State settled = settled_mono_bed(bed);
+    struct Level {
+        const char* model;
+        double mu, gamma_n;
+        bool spin, walls, moving;
+    };
+    const Level levels[] = {{"normal", 0.0, 0.0, false, false, false},
+                            {"damping", 0.0, 60.0, false, false, false},
+                            {"rotation+friction+damping", 0.6, 60.0, true, false, false},
+                            {"rotation+friction+damping+walls", 0.6, 60.0, true, true, false},
+                            {"rotation+friction+damping+walls+moving_walls", 0.6, 60.0, true, true, true}};
+    for (const Level& l : levels) {
+        Scene s = bed;
+        s.material.mu = l.mu;
+        s.material.gamma_n = l.gamma_n;
+        if (!l.walls) s.walls.clear();
+        if (l.moving)
+            for (Wall& w : s.walls)
+                if (w.name == "x_max") w.velocity = {-0.5, 0.0, 0.0};
+        State st = settled;
+        if (!l.spin)
+            for (std::vector<Vec3d>* q : {&st.rot.x, &st.rot.v, &st.rot.a, &st.rot.b3, &st.rot.b4, &st.rot.b5})
+                std::fill(q->begin(), q->end(), Vec3d{});
+        st.walls = continue_walls(s, st);
+        Problem c(s, st);
+        demmat::Setup full = c.setup();
+        full.widen = ModelFeatures::full();
+        VariantRun a(make_fast_variant(FastOptions{}), c.setup()), b(make_fast_variant(FastOptions{}), full);
+        EXPECT_EQ(a.variant->model().name(), l.model);
+        EXPECT_EQ(b.variant->model(), ModelFeatures::full());
+        std::string difference;
+        std::int64_t contacts = 0, walls = 0;
+        for (int k = 1; k <= 400 && difference.empty(); ++k) {
+            a.driver->step();
+            b.driver->step();
+            if (const auto d = first_difference(a.snapshot(), b.snapshot())) difference = fmt::format("step {}: {}", k, d->describe());
+            contacts = std::max(contacts, a.variant->counts().particle_particle);
+            walls = std::max(walls, a.variant->counts().particle_wall);
+        }
+        EXPECT_EQ(difference, "") << l.model;
+        State sa, sb;
+        a.variant->save(sa);
+        b.variant->save(sb);
+        EXPECT_EQ(state_difference(sa, sb), "") << l.model;
+        EXPECT_GT(contacts, 500) << l.model;  // contact-rich, so a skipped feature had work to skip
+        if (l.walls) EXPECT_GT(walls, 50) << l.model;
+    }
+}
+
+TEST(Fast, TheFeatureChainComparisonSeesADampingTermThatIsNotInert)
+{
+    // Control: the comparison above, with the full run given γ_n = 60 where the scene says 0, differs.
+    Scene bed = dense_bed_scene(500);
+    bed.grid->radius_min = bed.grid->radius_max;
+    State st = settled_mono_bed(bed);
+    Scene s = bed;
+    s.material.mu = 0.0;
+    s.material.gamma_n = 0.0;
+    s.walls.clear();
+    for (std::vector<Vec3d>* q : {&st.rot.x, &st.rot.v, &st.rot.a, &st.rot.b3, &st.rot.b4, &st.rot.b5}) std::fill(q->begin(), q->end(), Vec3d{});
+    st.walls.clear();
+    Problem c(s, st);
+    demmat::Setup full = c.setup();
+    full.widen = ModelFeatures::full();
+    full.contact.gamma_n = 60.0;
+    VariantRun a(make_fast_variant(FastOptions{}), c.setup()), b(make_fast_variant(FastOptions{}), full);
+    for (int k = 0; k < 20; ++k) {
+        a.driver->step();
+        b.driver->step();
+    }
+    EXPECT_TRUE(first_difference(a.snapshot(), b.snapshot()));
 }

@@ -29,8 +29,9 @@ public:
         std::size_t team = 1;               // the threads that ran it
     };
 
-    Counts run(const NeighbourList& list, const CanonicalSums& sums, WallContacts& walls, Particles& p, const ContactParams<double>& params,
-               bool prefetch, bool parallel)
+    template <class M>
+    Counts run(const NeighbourList& list, const CanonicalSums& sums, WallContacts& walls, Particles& p, const LawInputs& law,
+               Quad* stretches, bool prefetch, bool parallel)
     {
         constexpr std::size_t kChunk = CanonicalSums::kChunk;
         const std::size_t n = p.n;
@@ -48,7 +49,7 @@ public:
             nclaims_ = limit;
         }
         if (rings_.size() < limit) rings_.resize(limit);
-        const PairKernel kernel(list, p, params, prefetch);
+        const PairKernel<M> kernel(list, p, law, stretches, prefetch);
 #pragma omp parallel reduction(+ : pp, pw) if (parallel)
         {
             const std::size_t nt = std::size_t(thread_count()), t = std::size_t(thread_index());
@@ -68,7 +69,7 @@ public:
             if (ring.size() < ring_slots + 2) ring.assign(ring_slots + 2, Slot{});
             ring[ring_slots] = ring[ring_slots + 1] = Slot{};  // a larger ring from before may hold slots there
             // The kernel's records and every list of wall candidates are ready (predict(), or a rebuild).
-            pw += walls.compute(p, params);
+            if constexpr (M::walls) pw += walls.compute<M>(p, law);
 #pragma omp barrier
             const std::size_t c0 = piece_chunk_[pc], c1 = piece_chunk_[pc + 1];
             const SlotSink in_ring{ring.data(), ring_slots - 1, nullptr};
@@ -76,7 +77,7 @@ public:
                 // Slots near the end of a piece are also kept in all_, for the sums that straddle two pieces.
                 const bool edge = (pc > 0 && ch < c0 + span) || (pc + 1 < pieces && ch + span >= c1);
                 const SlotSink sink{in_ring.ring, in_ring.mask, edge ? all_.data() : nullptr};
-                pp += kernel.run<true>(std::size_t(pstart[ch * kChunk]), std::size_t(pstart[std::min(n, (ch + 1) * kChunk)]), nullptr, sink);
+                pp += kernel.template run<true>(std::size_t(pstart[ch * kChunk]), std::size_t(pstart[std::min(n, (ch + 1) * kChunk)]), nullptr, sink);
                 // The groups of this chunk's schedule; a group with a particle that straddles the end of
                 // the piece (three threads or more) goes a particle at a time, without that one.
                 const SlotSource from{in_ring.ring, in_ring.ring, in_ring.mask, 0};

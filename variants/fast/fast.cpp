@@ -1,223 +1,55 @@
-// The fast variant: data-oriented, vectorised, OpenMP multi-threaded, and still bit-identical to arrays
-// for any number of threads (docs/variants.md, "fast"). This file is the Variant: it owns the parts and
-// runs the phases; each part is a header of its own.
-//
-// - particles.hpp: the state in storage (cell) order, a structure of arrays, and predict()'s one pass
-//   between two force passes (the corrector of one step fused with the predictor of the next, the
-//   displacement check, the kernels' records).
-// - cell_order.hpp, neighbour_list.hpp: the cell sort at each rebuild and the list with a skin, rebuilt
-//   only when the displacement check says it must be (a superset of the contact set: the shared law
-//   alone decides h > 0, so the contacts are those of a search every step).
-// - wall_contacts.hpp: the walls each particle may touch, listed per thread, and their law on lanes.
-// - quads.hpp, pair_kernel.hpp: the pair law on lanes, the records moved by transposes of whole vectors.
-// - canonical_sums.hpp, canonical_sweep.hpp: each particle's sum in the canonical order of physics.md
-//   §6, in one sweep with the kernel shared among the threads (team.hpp); no sum depends on which thread
-//   did what, so the bits do not depend on the thread count.
-// - unordered_forces.hpp: fast_unordered (FastOptions::canonical = false), plain accumulation.
-#include "fast.hpp"
-
-#include <algorithm>
-#include <array>
-#include <cstdint>
+// The fast variant's registration and its dispatch: init() picks the instantiation of Fast<M>
+// (fast_variant.hpp) for what the scene needs (fast_models.hpp) and forwards every phase to it.
 #include <memory>
 #include <utility>
-#include <vector>
 
-#include "canonical_sums.hpp"
-#include "canonical_sweep.hpp"
-#include "cell_order.hpp"
+#include "demmat/error.hpp"
+#include "demmat/features.hpp"
 #include "demmat/registry.hpp"
-#include "neighbour_list.hpp"
-#include "particles.hpp"
-#include "team.hpp"
-#include "unordered_forces.hpp"
-#include "wall_contacts.hpp"
+#include "fast.hpp"
+#include "fast_models.hpp"
 
 namespace demmat {
 namespace {
 
 using namespace demmat::fast;
 
-class Fast final : public FastVariant {
+class FastDispatch final : public FastVariant {
 public:
-    explicit Fast(const FastOptions& o) : opt_(o) {}
+    explicit FastDispatch(const FastOptions& o) : opt_(o) {}
+
+    // Every law of physics.md §9 in the canonical order (gear5 in double); fast_unordered the paper's only.
+    bool supports(const ContactModel& law) const override { return opt_.canonical || law.is_paper(); }
 
     void init(const Setup& setup) override
     {
-        const State& s = *setup.state;
-        step_ = s.step;
-        params_ = setup.contact;
-        p_.init(setup);
-        walls_.init(s.walls, setup.scene->dt, p_.n);
-        // Below min_parallel one thread: a fork and join per phase would cost more than the work shared.
-        par_ = p_.n >= opt_.min_parallel;
-        prefetch_ = p_.n >= opt_.prefetch_from;
-        skin_ = opt_.skin * setup.radius_max;
-        // Cells at least as wide as the longest listed pair; a wider scene cell is honoured (it only
-        // changes the candidates, never the contact set).
-        cell_ = std::max(setup.cell_size, 2.0 * setup.radius_max) + skin_;
-        walls_.place(step_);
-        list_.start.assign(p_.n + 1, 0);
-        rebuilds_ = 0;
-        team_ = 0;
-        rebuild();
+        const ModelFeatures need = model_for(setup);
+        if (need.beyond_paper() && !opt_.canonical) throw Error("fast_unordered runs the paper's contact law only");
+        if (need.beyond_paper()) impl_ = make_fast_law(need, opt_);
+        else if (need.polydisperse) impl_ = make_fast_paper_poly(paper_level(need), opt_);
+        else impl_ = make_fast_paper_mono(paper_level(need), opt_);
+        impl_->init(setup);
     }
-
-    // One pass over the particles between two force passes, timed as the predictor: everything that
-    // streams the per-particle arrays, done a block at a time while the block is in cache, instead of a
-    // pass each (particles.hpp). The driver finds correct() empty and search() a rebuild or nothing.
-    void predict(std::int64_t step) override
-    {
-        step_ = step;
-        walls_.place(step);
-        const bool fused = p_.corrector_pending;
-        p_.corrector_pending = false;
-        walls_.reserve_lists();
-        // Rebuild when a pair may have closed by more than the skin since the last rebuild:
-        // |Δx_i| + |Δx_j| ≤ 2·max|Δx|. 0.9 leaves room for rounding; a NaN fails the test and goes to
-        // the rebuild, whose cell search reports it. (Walls need no list: see wall_contacts.hpp.)
-        const double half = 0.9 * skin_ * 0.5;
-        int over = !(half > 0.0);
-        std::size_t listing_team = 1;
-        const std::size_t n = p_.n;
-#pragma omp parallel reduction(| : over) if (par_)
-        {
-            const auto [lo, hi] = thread_range(n);
-            const std::size_t t = std::size_t(thread_index());
-            if (t == 0) listing_team = std::size_t(thread_count());
-            walls_.clear_list(t);
-            for (std::size_t b0 = lo; b0 < hi; b0 += kPassBlock) {
-                const std::size_t b1 = std::min(hi, b0 + kPassBlock);
-                p_.integrate(b0, b1, fused);
-                over |= p_.moved_too_far(b0, b1, half * half);
-                p_.refresh_records(b0, b1);
-                walls_.list(p_, b0, b1, t);
-            }
-            walls_.size_results(t);
-        }
-        walls_.listed_by(listing_team, n);
-        rebuild_due_ = over != 0;
-    }
-
-    void search() override
-    {
-        if (rebuild_due_) rebuild();
-    }
-
-    void forces() override
-    {
-        if (opt_.canonical) {
-            const auto c = sweep_.run(list_, sums_, walls_, p_, params_, prefetch_, par_);
-            pp_ = c.pairs;
-            pw_ = c.walls;
-            team_ = c.team;
-        } else {
-            const auto c = unordered_.run(list_, walls_, p_, params_, prefetch_, par_);
-            pp_ = c.pairs;
-            pw_ = c.walls;
-            team_ = c.team;
-        }
-    }
-
-    // Deferred to the next predict() (fused with its predictor), or applied by snapshot() and save() to
-    // what they read.
-    void correct() override { p_.corrector_pending = true; }
-
-    void snapshot(Snapshot& out) const override
-    {
-        const std::size_t n = p_.n;
-        out.resize(n);
-        out.step = step_;
-        for (std::size_t i = 0; i < n; ++i) {
-            const std::size_t s = std::size_t(p_.pos[i]);
-            const std::array<Vec3d, 6> trans = p_.gear_state(false, s);
-            out.position[i] = trans[0];
-            out.velocity[i] = trans[1];
-            out.angular_velocity[i] = p_.gear_state(true, s)[1];
-            out.force[i] = p_.get(p_.f, s);
-            out.torque[i] = p_.get(p_.t, s);
-        }
-    }
-
-    void save(State& out) const override
-    {
-        const std::size_t n = p_.n;
-        out.resize(n);
-        out.step = step_;
-        out.walls = walls_.walls();
-        std::vector<Vec3d>* dst[2][6] = {{&out.trans.x, &out.trans.v, &out.trans.a, &out.trans.b3, &out.trans.b4, &out.trans.b5},
-                                         {&out.rot.x, &out.rot.v, &out.rot.a, &out.rot.b3, &out.rot.b4, &out.rot.b5}};
-        for (int rot = 0; rot < 2; ++rot)
-            for (std::size_t i = 0; i < n; ++i) {
-                const std::array<Vec3d, 6> g = p_.gear_state(rot == 1, std::size_t(p_.pos[i]));
-                for (int k = 0; k < 6; ++k) (*dst[rot][k])[i] = g[std::size_t(k)];
-            }
-        for (std::size_t i = 0; i < n; ++i) out.radius[i] = p_.r[std::size_t(p_.pos[i])];
-    }
-
-    ContactCounts counts() const override { return {pp_, pw_, std::int64_t(list_.pairs())}; }
-    std::int64_t rebuilds() const override { return rebuilds_; }
-    // The team of the last force pass; before one, the team it will get (one below min_parallel).
-    int threads_used() const override { return team_ > 0 ? int(team_) : par_ ? thread_limit() : 1; }
-
-    std::size_t memory_bytes() const override
-    {
-        return p_.bytes() + cells_.bytes() + list_.bytes() + walls_.bytes() + sums_.bytes() + sweep_.bytes() + unordered_.bytes();
-    }
+    void predict(std::int64_t step) override { impl_->predict(step); }
+    void search() override { impl_->search(); }
+    void forces() override { impl_->forces(); }
+    void correct() override { impl_->correct(); }
+    void snapshot(Snapshot& out) const override { impl_->snapshot(out); }
+    void save(State& out) const override { impl_->save(out); }
+    ContactCounts counts() const override { return impl_ ? impl_->counts() : ContactCounts{}; }
+    std::size_t memory_bytes() const override { return impl_ ? impl_->memory_bytes() : 0; }
+    ModelFeatures model() const override { return impl_ ? impl_->model() : ModelFeatures::full(); }
+    int threads_used() const override { return impl_ ? impl_->threads_used() : 1; }
+    std::int64_t rebuilds() const override { return impl_ ? impl_->rebuilds() : 0; }
 
 private:
-    // Particles per block of predict()'s pass, whose arrays stay in cache from one step of the pass to
-    // the next.
-    static constexpr std::size_t kPassBlock = 1024;
-
-    // Re-sorts the particles into cell order, lists the pairs (and plans the canonical sums), and makes
-    // the new storage order's records and wall candidates (predict() made them for the old one).
-    void rebuild()
-    {
-        ++rebuilds_;
-        const std::size_t n = p_.n;
-        if (n == 0) return;
-        cells_.sort(p_.x, p_.id, n, cell_);
-        p_.permute([this](std::size_t s) { return std::size_t(cells_.key(s).from); }, [this](std::size_t s) { return cells_.key(s).id; },
-                   par_);
-        list_.build(p_, cells_, skin_, opt_.canonical, par_);
-        if (opt_.canonical) sums_.plan(list_, n);
-        p_.xref = p_.x;
-        walls_.reserve_lists();
-        std::size_t listing_team = 1;
-#pragma omp parallel if (par_)
-        {
-            const auto [lo, hi] = thread_range(n);
-            const std::size_t t = std::size_t(thread_index());
-            if (t == 0) listing_team = std::size_t(thread_count());
-            p_.refresh_records(lo, hi);
-            walls_.clear_list(t);
-            walls_.list(p_, lo, hi, t);
-            walls_.size_results(t);
-        }
-        walls_.listed_by(listing_team, n);
-    }
-
     FastOptions opt_;
-    bool par_ = true, prefetch_ = false;
-    bool rebuild_due_ = false;  // the displacement check of the last predict() asks for a rebuild
-    std::int64_t step_ = 0, rebuilds_ = 0;
-    double skin_ = 0.0, cell_ = 0.0;
-    ContactParams<double> params_;
-    Particles p_;
-    CellOrder cells_;
-    NeighbourList list_;
-    WallContacts walls_;
-    CanonicalSums sums_;
-    CanonicalSweep sweep_;
-    UnorderedForces unordered_;
-    std::int64_t pp_ = 0, pw_ = 0;
-    std::size_t team_ = 0;  // the threads of the last force pass (0: none yet)
+    std::unique_ptr<FastVariant> impl_;
 };
 
 } // namespace
 
-std::unique_ptr<FastVariant> make_fast_variant(const FastOptions& options) { return std::make_unique<Fast>(options); }
+std::unique_ptr<FastVariant> make_fast_variant(const FastOptions& options) { return std::make_unique<FastDispatch>(options); }
 
 void register_variant_fast(Registry& r)
 {

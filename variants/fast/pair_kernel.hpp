@@ -1,14 +1,19 @@
 #pragma once
-// The fast variant's pair kernel: a run of listed pairs (slots) through the contact law on lanes. Each
-// lane has the scalar law's bits (particle_contact_lanes is the scalar law's template code on packs), so
-// the contacts are those of arrays; what becomes of them is the caller's: written into their slots
-// (canonical order, summed later) or added to both particles' loads as they come (fast_unordered).
+// The fast variant's pair kernel: a run of listed pairs (slots) through the contact law on lanes, for
+// the run's model M (model.hpp). Each lane has the scalar law's bits (particle_contact_lanes and
+// particle_contact_memory_lanes are the scalar laws' template code on packs), so the contacts are those
+// of arrays; what becomes of them is the caller's: written into their slots (canonical order, summed
+// later) or added to both particles' loads as they come (fast_unordered). Under a law with memory each
+// slot's stretches (pair_stretches.hpp) go through the lanes with it and come back, zeroed where the
+// pair is out of contact (a contact that ends is forgotten, as in arrays).
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
 
 #include "demmat/contact_law.hpp"
+#include "demmat/contact_memory.hpp"
 #include "neighbour_list.hpp"
+#include "pair_stretches.hpp"
 #include "particles.hpp"
 #include "quads.hpp"
 #include "wall_contacts.hpp"
@@ -27,14 +32,18 @@ struct SlotSink {
     Slot* ring = nullptr;
     std::size_t mask = 0;
     Slot* all = nullptr;
-    void put(std::size_t k, const Slot& v) const
+    [[gnu::always_inline]] void put(std::size_t k, const Slot& v) const
     {
         ring[k & mask] = v;
         if (all) all[k] = v;
     }
 };
 
+template <class M>
 class PairKernel {
+    static constexpr bool kLaw = M::restitution_damping || M::history || M::rolling;
+    static constexpr std::size_t kQ = std::size_t(stretch_quads<M>);
+
 public:
     // From FastOptions::prefetch_from particles on, the kernel prefetches its partners' records
     // kPrefetch candidates ahead (and in fast_unordered their loads): owners come in storage order,
@@ -42,9 +51,9 @@ public:
     // in large beds the records no longer stay in the caches between force passes.
     static constexpr std::size_t kPrefetch = 128;
 
-    PairKernel(const NeighbourList& list, const Particles& p, const ContactParams<double>& params, bool prefetch)
-        : owner_(list.owner.data()), partner_(list.partner.data()), pairs_(list.pairs()), kin_(p.kin.data()), params_(params),
-          prefetch_(prefetch)
+    PairKernel(const NeighbourList& list, const Particles& p, const LawInputs& law, Quad* stretches, bool prefetch)
+        : owner_(list.owner.data()), partner_(list.partner.data()), pairs_(list.pairs()), kin_(p.kin.data()), law_(law),
+          stretch_(stretches), prefetch_(prefetch)
     {
     }
 
@@ -100,6 +109,9 @@ public:
             }
             if constexpr (Canonical)
                 for (std::size_t e = 0; e < nd; ++e) sink.put(dropped[e], Slot{});
+            if constexpr (kQ > 0)  // out of contact: the stretch is forgotten
+                for (std::size_t e = 0; e < nd; ++e)
+                    for (std::size_t q = 0; q < kQ; ++q) stretch_[dropped[e] * kQ + q] = Quad{};
             for (std::size_t e = 0; e < nk; e += kLanes)
                 found += pack<Canonical>(kept + e, int(std::min<std::size_t>(kLanes, nk - e)), load, sink);
         }
@@ -114,7 +126,7 @@ private:
     // computed from R and m in the lanes: cheaper than reading them from a per-pair array), and the lanes
     // transposed back into the slots (zeros where h <= 0) or added to the loads.
     template <bool Canonical>
-    int pack(const std::size_t* ks, int count, Load* load, const SlotSink& sink) const
+    [[gnu::flatten]] int pack(const std::size_t* ks, int count, Load* load, const SlotSink& sink) const
     {
         std::size_t k[kLanes], s[kLanes], q[kLanes];
         for (int l = 0; l < kLanes; ++l) {
@@ -131,10 +143,20 @@ private:
         gather_lanes([&](int l) -> const Quad& { return kin[s[l]].w; }, wi);
         gather_lanes([&](int l) -> const Quad& { return kin[q[l]].w; }, wj);
         ContactForce<Lanes> c;
-        const auto touch = particle_contact_lanes<FullModel>(
-            Vec3<Lanes>{xi[0], xi[1], xi[2]}, Vec3<Lanes>{xj[0], xj[1], xj[2]}, Vec3<Lanes>{vi[0], vi[1], vi[2]},
-            Vec3<Lanes>{vj[0], vj[1], vj[2]}, Vec3<Lanes>{wi[0], wi[1], wi[2]}, Vec3<Lanes>{wj[0], wj[1], wj[2]}, xi[3], xj[3], vi[3],
-            vj[3], params_, Coefficients<Lanes>{}, c);
+        const Vec3<Lanes> pi{xi[0], xi[1], xi[2]}, pj{xj[0], xj[1], xj[2]}, ui{vi[0], vi[1], vi[2]}, uj{vj[0], vj[1], vj[2]},
+            oi{wi[0], wi[1], wi[2]}, oj{wj[0], wj[1], wj[2]};
+        const auto touch = [&] {
+            if constexpr (kLaw) {
+                Stretch<Lanes> st;
+                if constexpr (kQ > 0) lanes_from_records<M>(stretch_, k, st);
+                const auto t = particle_contact_memory_lanes<M>(pi, pj, ui, uj, oi, oj, xi[3], xj[3], vi[3], vj[3], law_.params,
+                                                                law_.memory, st, true, c);
+                if constexpr (kQ > 0) lanes_to_records<M>(stretch_, k, count, t, st);
+                return t;
+            } else {
+                return particle_contact_lanes<M>(pi, pj, ui, uj, oi, oj, xi[3], xj[3], vi[3], vj[3], law_.params, law_.mono_pp, c);
+            }
+        }();
         int found = 0;
         for (int l = 0; l < count; ++l) found += int(touch[l] != 0);
         if constexpr (Canonical) {
@@ -174,7 +196,8 @@ private:
     const Index* partner_;
     std::size_t pairs_;
     const Kin* kin_;
-    const ContactParams<double>& params_;
+    const LawInputs& law_;
+    Quad* stretch_;  // kQ quads per slot (a law with memory), else unused
     bool prefetch_;
 };
 

@@ -78,6 +78,8 @@ public:
     // The Gear step of particles [b0, b1): the pending corrector (accelerations from the last force
     // pass, a = F/m + g and α = T/I, as Newton's law in arrays) fused with the predictor, or the
     // predictor alone after init. A component block at a time: seven streams in, six out, vectorised.
+    // Without rotation (a model with !rotation) the rotational state stays as it is: all zeros, as in arrays.
+    template <bool Rotation>
     void integrate(std::size_t b0, std::size_t b1, bool fused)
     {
         const GearCoefficients<double> k = gear_;
@@ -95,13 +97,17 @@ public:
             if (fused) {
 #pragma omp simd
                 for (std::size_t s = b0; s < b1; ++s) correct_predict(px[s], pv[s], pa[s], p3[s], p4[s], p5[s], acceleration(pf[s], mass[s], g), k);
+                if constexpr (Rotation) {
 #pragma omp simd
-                for (std::size_t s = b0; s < b1; ++s) correct_predict(qx[s], qv[s], qa[s], q3[s], q4[s], q5[s], pt[s] / inert[s], k);
+                    for (std::size_t s = b0; s < b1; ++s) correct_predict(qx[s], qv[s], qa[s], q3[s], q4[s], q5[s], pt[s] / inert[s], k);
+                }
             } else {
 #pragma omp simd
                 for (std::size_t s = b0; s < b1; ++s) gear_predict(px[s], pv[s], pa[s], p3[s], p4[s], p5[s], k);
+                if constexpr (Rotation) {
 #pragma omp simd
-                for (std::size_t s = b0; s < b1; ++s) gear_predict(qx[s], qv[s], qa[s], q3[s], q4[s], q5[s], k);
+                    for (std::size_t s = b0; s < b1; ++s) gear_predict(qx[s], qv[s], qa[s], q3[s], q4[s], q5[s], k);
+                }
             }
         }
     }

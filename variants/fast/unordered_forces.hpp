@@ -25,14 +25,15 @@ public:
         std::size_t team = 1;
     };
 
-    Counts run(const NeighbourList& list, WallContacts& walls, Particles& p, const ContactParams<double>& params, bool prefetch, bool parallel)
+    template <class M>
+    Counts run(const NeighbourList& list, WallContacts& walls, Particles& p, const LawInputs& law, bool prefetch, bool parallel)
     {
         const std::size_t n = p.n;
         const std::size_t limit = std::size_t(thread_limit());
         if (loads_.size() < limit) loads_.resize(limit);
         std::int64_t pp = 0, pw = 0;
         std::size_t team = 1;
-        const PairKernel kernel(list, p, params, prefetch);
+        const PairKernel<M> kernel(list, p, law, nullptr, prefetch);
 #pragma omp parallel reduction(+ : pp, pw) if (parallel)
         {
             const std::size_t nt = std::size_t(thread_count()), t = std::size_t(thread_index());
@@ -45,8 +46,8 @@ public:
             if (mine.size() != n) mine.resize(n);
             const auto [z0, z1] = span(t);
             std::fill(mine.begin() + std::ptrdiff_t(z0), mine.begin() + std::ptrdiff_t(z1), Load{});
-            pw += walls.compute(p, params);  // the lists and records were made by predict() or a rebuild
-            pp += kernel.run<false>(std::size_t(list.start[lo]), std::size_t(list.start[hi]), mine.data());
+            if constexpr (M::walls) pw += walls.compute<M>(p, law);  // the lists and records were made by predict() or a rebuild
+            pp += kernel.template run<false>(std::size_t(list.start[lo]), std::size_t(list.start[hi]), mine.data());
 #pragma omp barrier
             for (std::size_t s = lo; s < hi; ++s) {
                 Quad f{}, tq{};
