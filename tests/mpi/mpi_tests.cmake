@@ -1,0 +1,33 @@
+# The mpi variant's tests (variants/mpi), where MPI was found: each ctest starts a program under mpirun.
+# Open MPI's --oversubscribe lets R ranks share the machine's cores (CI has 2), --allow-run-as-root lets
+# CI run them as root. The short runs at R = 1–4 are in the default set; R = 8 and the long runs carry the
+# label `long` (scripts/run_long_tests.sh), as the gtest suites named *Long do.
+set(DEMMAT_MPIRUN ${MPIEXEC_EXECUTABLE} --oversubscribe --allow-run-as-root ${MPIEXEC_PREFLAGS})
+set(DEMMAT_MPIRUN ${DEMMAT_MPIRUN} PARENT_SCOPE)
+
+add_executable(demmat_mpi_tests mpi/test_mpi.cpp)
+target_link_libraries(demmat_mpi_tests PRIVATE demmat_mpi_variant demmat_variants GTest::gtest)
+target_include_directories(demmat_mpi_tests PRIVATE ${CMAKE_CURRENT_SOURCE_DIR})
+if(DEMMAT_SANITIZE)
+  target_compile_definitions(demmat_mpi_tests PRIVATE DEMMAT_SANITIZED=1)
+endif()
+
+function(demmat_mpi_test name ranks filter)
+  cmake_parse_arguments(T "LONG" "" "" ${ARGN})
+  add_test(NAME ${name}
+           COMMAND ${DEMMAT_MPIRUN} ${MPIEXEC_NUMPROC_FLAG} ${ranks} $<TARGET_FILE:demmat_mpi_tests> --gtest_filter=${filter}
+                   ${MPIEXEC_POSTFLAGS}
+           WORKING_DIRECTORY ${CMAKE_CURRENT_BINARY_DIR})  # beside demmat_tests: the settled bed's cache is shared
+  set_tests_properties(${name} PROPERTIES TIMEOUT 1800 PROCESSORS ${ranks} ENVIRONMENT "${DEMMAT_MPI_TEST_ENV}")
+  if(T_LONG)
+    set_tests_properties(${name} PROPERTIES LABELS long)
+  endif()
+endfunction()
+
+foreach(r 1 2 3 4)
+  demmat_mpi_test(mpi.equivalence.np${r} ${r} "MpiEquivalence.*")
+endforeach()
+demmat_mpi_test(mpi.equivalence.np8 8 "MpiEquivalence.*" LONG)
+foreach(r 1 2 3 4 8)
+  demmat_mpi_test(mpi.equivalence_long.np${r} ${r} "MpiEquivalenceLong.*" LONG)
+endforeach()

@@ -1,0 +1,387 @@
+#pragma once
+// The phases on one rank (docs/variants.md, "mpi"), for model M (model.hpp), gear5 in double:
+//
+//   predict  the Gear predictor on the owned particles; moving walls placed from the step number (every
+//            rank computes the same wall positions, nothing is sent for them)
+//   search   communicate: owned particles that left the slab migrate to the neighbour (with their
+//            whole Gear history), then each rank sends its neighbours ghost copies of its particles
+//            within the interaction range of the shared face; then the cell search over owned and
+//            ghosts keeps every pair with an owned particle that may_touch accepts
+//   forces   each pair's force once per rank, by the shared law with the lower id as i; each owned
+//            particle's sum in the canonical order (partners ascending by id, then walls in order)
+//   correct  the Gear corrector on the owned particles
+//
+// A pair that straddles a face is computed by both ranks from the same inputs (the same bits); no force
+// is sent back. So every owned particle receives exactly the terms arrays gives it, in arrays' order.
+#include <algorithm>
+#include <cstdint>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "comm.hpp"
+#include "mpi_variant.hpp"
+#include "rank_particles.hpp"
+#include "slabs.hpp"
+#include "demmat/contact_law.hpp"
+#include "demmat/error.hpp"
+#include "demmat/integrators.hpp"
+#include "demmat/linked_cells.hpp"
+
+namespace demmat::mpi {
+
+// What rank 0 decides at init and every rank receives: the model, the slabs, the lengths.
+struct Plan {
+    ModelFeatures features;
+    Slabs slabs;
+    double radius_max = 0.0;
+    double cell = 0.0;   // edge of the search's cells
+    double halo = 0.0;   // ghosts: particles within this distance of a shared face
+    double r0 = 0.0, m0 = 0.0;  // particle 0's radius and mass (a monodisperse model's coefficients)
+};
+
+template <class M>
+class RankProcessor final : public MpiVariant {
+public:
+    RankProcessor(const Comm& comm, const Plan& plan) : comm_(comm), plan_(plan) {}
+
+    void init(const Setup& setup) override
+    {
+        const State& s = *setup.state;
+        step_ = s.step;
+        dt_ = setup.scene->dt;
+        coef_ = GearCoefficients<double>::make(dt_);
+        params_ = setup.contact;
+        g_ = setup.scene->gravity;
+        walls_ = s.walls;
+        wp_.resize(walls_.size());
+        place_walls(step_);
+        if constexpr (!M::polydisperse) {
+            mono_pp_ = pair_coefficients(plan_.r0, plan_.r0, plan_.m0, plan_.m0, params_);
+            mono_pw_ = wall_coefficients(plan_.r0, plan_.m0, params_);
+        }
+        // Rank 0 holds the whole state: each rank receives its slab's particles as migrants.
+        std::vector<std::vector<double>> parts;
+        if (comm_.root()) {
+            parts.resize(std::size_t(comm_.size()));
+            const std::vector<Vec3d>* g[12] = {&s.trans.x, &s.trans.v, &s.trans.a, &s.trans.b3, &s.trans.b4, &s.trans.b5,
+                                               &s.rot.x,   &s.rot.v,   &s.rot.a,   &s.rot.b3,   &s.rot.b4,   &s.rot.b5};
+            for (std::size_t i = 0; i < s.size(); ++i) {
+                std::vector<double>& out = parts[std::size_t(plan_.slabs.owner(component(s.trans.x[i], plan_.slabs.axis)))];
+                out.push_back(id_to_double(std::int64_t(i)));
+                out.push_back(s.radius[i]);
+                out.push_back(setup.mass[i]);
+                out.push_back(setup.inertia[i]);
+                for (const auto* q : g)
+                    for (int c = 0; c < 3; ++c) out.push_back(component((*q)[i], c));
+            }
+        }
+        p_ = RankParticles{};
+        p_.add_migrants(comm_.scatter(parts));
+        for (std::size_t l = 0; l < p_.owned(); ++l) p_.f[l] = p_.t[l] = Vec3d{};
+        owned_max_ = std::int64_t(p_.owned());
+        steps_ = 0;
+        migrants_ = 0;
+    }
+
+    void predict(std::int64_t step) override
+    {
+        step_ = step;
+        for (std::size_t l = 0; l < p_.owned(); ++l) {
+            for (int c = 0; c < 3; ++c)
+                Gear5Scheme::predict(component(p_.x[l], c), component(p_.v[l], c), component(p_.a[l], c), component(p_.b3[l], c),
+                                     component(p_.b4[l], c), component(p_.b5[l], c), coef_);
+            if constexpr (M::rotation)
+                for (int c = 0; c < 3; ++c)
+                    Gear5Scheme::predict(component(p_.th[l], c), component(p_.w[l], c), component(p_.al[l], c),
+                                         component(p_.q3[l], c), component(p_.q4[l], c), component(p_.q5[l], c), coef_);
+        }
+        if constexpr (M::moving_walls) place_walls(step);
+    }
+
+    void search() override
+    {
+        migrate();
+        exchange_ghosts();
+        find_pairs();
+        if constexpr (M::walls) find_walls();
+        ++steps_;
+        owned_max_ = std::max(owned_max_, std::int64_t(p_.owned()));
+    }
+
+    void forces() override
+    {
+        const std::size_t np = pairs_.size();
+        pf_.resize(np);
+        live_.resize(np);
+        pp_ = 0;
+        pw_ = 0;
+        candidates_ = 0;
+        const std::size_t no = p_.owned();
+        for (std::size_t k = 0; k < np; ++k) {
+            const auto [i, j] = pairs_[k];
+            live_[k] = particle_contact<M>(p_.x[i], p_.x[j], p_.v[i], p_.v[j], p_.w[i], p_.w[j], p_.r[i], p_.r[j], p_.m[i], p_.m[j],
+                                           params_, mono_pp_, pf_[k]);
+            if (std::size_t(i) < no) {  // counted where the lower id is owned: once over all ranks
+                ++candidates_;
+                if (live_[k]) ++pp_;
+            }
+        }
+        for (std::size_t l = 0; l < no; ++l) {
+            Vec3d f{}, t{};
+            for (std::size_t e = row_start_[l]; e < row_start_[l + 1]; ++e) {
+                const Entry& en = rows_[e];
+                if (!live_[std::size_t(en.pair)]) continue;  // a pair the law rejects adds nothing, not even a zero
+                const ContactForce<double>& c = pf_[std::size_t(en.pair)];
+                if (en.lower) {
+                    f = f + c.f_i;
+                    if constexpr (M::rotation) t = t + c.t_i;
+                } else {
+                    f = f + (-c.f_i);
+                    if constexpr (M::rotation) t = t + c.t_j;
+                }
+            }
+            if constexpr (M::walls)
+                for (std::size_t e = wall_start_[l]; e < wall_start_[l + 1]; ++e) {
+                    const Wall& wl = walls_[std::size_t(wall_rows_[e])];
+                    ContactForce<double> c;
+                    if (!wall_contact<M>(p_.x[l], p_.v[l], p_.w[l], p_.r[l], p_.m[l], wp_[std::size_t(wall_rows_[e])], wl.normal,
+                                         wl.velocity, params_, mono_pw_, c))
+                        continue;
+                    ++pw_;
+                    f = f + c.f_i;
+                    if constexpr (M::rotation) t = t + c.t_i;
+                }
+            p_.f[l] = f;
+            p_.t[l] = t;
+            p_.acc[l] = {acceleration(f.x, p_.m[l], g_.x), acceleration(f.y, p_.m[l], g_.y), acceleration(f.z, p_.m[l], g_.z)};
+            if constexpr (M::rotation) p_.alc[l] = t / p_.inertia[l];
+        }
+    }
+
+    void correct() override
+    {
+        for (std::size_t l = 0; l < p_.owned(); ++l) {
+            for (int c = 0; c < 3; ++c)
+                Gear5Scheme::correct(component(p_.x[l], c), component(p_.v[l], c), component(p_.a[l], c), component(p_.b3[l], c),
+                                     component(p_.b4[l], c), component(p_.b5[l], c), component(p_.acc[l], c), coef_);
+            if constexpr (M::rotation)
+                for (int c = 0; c < 3; ++c)
+                    Gear5Scheme::correct(component(p_.th[l], c), component(p_.w[l], c), component(p_.al[l], c),
+                                         component(p_.q3[l], c), component(p_.q4[l], c), component(p_.q5[l], c),
+                                         component(p_.alc[l], c), coef_);
+        }
+    }
+
+    void snapshot(Snapshot& out) const override
+    {
+        std::vector<double> mine;
+        mine.reserve(16 * p_.owned());
+        for (std::size_t l = 0; l < p_.owned(); ++l) {
+            mine.push_back(id_to_double(p_.id[l]));
+            for (const Vec3d* q : {&p_.x[l], &p_.v[l], &p_.w[l], &p_.f[l], &p_.t[l]})
+                for (int c = 0; c < 3; ++c) mine.push_back(component(*q, c));
+        }
+        const std::vector<double> all = comm_.gather(mine);
+        out.step = step_;
+        out.resize(all.size() / 16);
+        for (std::size_t k = 0; k + 16 <= all.size(); k += 16) {
+            const std::size_t i = std::size_t(double_to_id(all[k]));
+            const double* q = &all[k + 1];
+            Vec3d* dst[5] = {&out.position[i], &out.velocity[i], &out.angular_velocity[i], &out.force[i], &out.torque[i]};
+            for (Vec3d* d : dst) {
+                *d = {q[0], q[1], q[2]};
+                q += 3;
+            }
+        }
+    }
+
+    void save(State& out) const override
+    {
+        std::vector<double> mine;
+        mine.reserve(kMigrantDoubles * p_.owned());
+        for (std::size_t l = 0; l < p_.owned(); ++l) p_.pack_migrant(l, mine);
+        const std::vector<double> all = comm_.gather(mine);
+        out = State{};
+        out.step = step_;
+        out.walls = walls_;
+        out.resize(all.size() / kMigrantDoubles);
+        std::vector<Vec3d>* g[12] = {&out.trans.x, &out.trans.v, &out.trans.a, &out.trans.b3, &out.trans.b4, &out.trans.b5,
+                                     &out.rot.x,   &out.rot.v,   &out.rot.a,   &out.rot.b3,   &out.rot.b4,   &out.rot.b5};
+        for (std::size_t k = 0; k + kMigrantDoubles <= all.size(); k += kMigrantDoubles) {
+            const double* q = &all[k];
+            const std::size_t i = std::size_t(double_to_id(q[0]));
+            out.radius[i] = q[1];  // as given: a continued run derives the same masses
+            q += 4;
+            for (auto* d : g) {
+                (*d)[i] = {q[0], q[1], q[2]};
+                q += 3;
+            }
+        }
+    }
+
+    ContactCounts counts() const override { return {comm_.sum(pp_), comm_.sum(pw_), comm_.sum(candidates_)}; }
+    std::size_t memory_bytes() const override
+    {
+        return p_.memory_bytes() + pairs_.capacity() * sizeof(Pair) + rows_.capacity() * sizeof(Entry) +
+               (row_start_.capacity() + wall_start_.capacity()) * sizeof(std::size_t) + wall_rows_.capacity() * sizeof(std::int32_t) +
+               pf_.capacity() * sizeof(ContactForce<double>) + live_.capacity() + cells_.memory_bytes();
+    }
+    ModelFeatures model() const override { return ModelFeatures::of<M>(); }
+
+    const Comm& comm() const override { return comm_; }
+    double communicate_seconds() const override { return comm_.traffic().seconds; }
+    const Slabs& slabs() const override { return plan_.slabs; }
+    std::vector<RankReport> rank_reports() const override
+    {
+        const Traffic& tr = comm_.traffic();
+        const std::vector<double> mine = {double(comm_.rank()), double(p_.owned()), double(p_.size() - p_.owned()), double(owned_max_),
+                                          double(steps_), double(migrants_), double(tr.messages), double(tr.bytes), tr.seconds};
+        const std::vector<double> all = comm_.gather(mine);
+        std::vector<RankReport> out;
+        for (std::size_t k = 0; k + 9 <= all.size(); k += 9)
+            out.push_back({int(all[k]), std::int64_t(all[k + 1]), std::int64_t(all[k + 2]), std::int64_t(all[k + 3]), std::int64_t(all[k + 4]),
+                           std::int64_t(all[k + 5]), Traffic{std::int64_t(all[k + 6]), std::int64_t(all[k + 7]), all[k + 8]}});
+        return out;
+    }
+
+private:
+    struct Pair {
+        std::int32_t i, j;  // local indices, id[i] < id[j]
+    };
+    struct Entry {
+        std::int64_t partner;  // the partner's id: the key of the canonical order
+        std::int32_t pair;
+        bool lower;            // this particle is the pair's i (the lower id)
+    };
+
+    void place_walls(std::int64_t step)
+    {
+        for (std::size_t w = 0; w < walls_.size(); ++w) wp_[w] = walls_[w].point_at(step, dt_);
+    }
+
+    double axis_coordinate(std::size_t l) const { return component(p_.x[l], plan_.slabs.axis); }
+
+    // Owned particles whose predicted position left the slab go to the neighbour that now owns it.
+    void migrate()
+    {
+        p_.drop_ghosts();
+        down_.clear();
+        up_.clear();
+        const int me = comm_.rank();
+        for (std::size_t l = 0; l < p_.owned();) {
+            const int to = plan_.slabs.owner(axis_coordinate(l));
+            if (to == me) {
+                ++l;
+                continue;
+            }
+            if (to != me - 1 && to != me + 1)
+                throw InstabilityError(fmt::format("particle {} moved across more than one slab in a step (from rank {} to {}): the run "
+                                                   "has blown up", p_.id[l], me, to), -1, p_.id[l]);
+            p_.pack_migrant(l, to < me ? down_ : up_);
+            p_.remove_owned(l);
+            ++migrants_;
+        }
+        comm_.exchange(down_, up_, from_down_, from_up_, 1);
+        p_.add_migrants(from_down_);
+        p_.add_migrants(from_up_);
+    }
+
+    // Copies of the owned particles within the halo of a shared face, for the neighbour across it.
+    void exchange_ghosts()
+    {
+        down_.clear();
+        up_.clear();
+        const int me = comm_.rank();
+        const double lo = plan_.slabs.cuts[std::size_t(me)], hi = plan_.slabs.cuts[std::size_t(me) + 1];
+        for (std::size_t l = 0; l < p_.owned(); ++l) {
+            const double c = axis_coordinate(l);
+            if (me > 0 && c - lo < plan_.halo) p_.pack_ghost(l, down_);
+            if (me + 1 < comm_.size() && hi - c < plan_.halo) p_.pack_ghost(l, up_);
+        }
+        comm_.exchange(down_, up_, from_down_, from_up_, 2);
+        p_.add_ghosts(from_down_);
+        p_.add_ghosts(from_up_);
+    }
+
+    // Every pair with an owned particle that may_touch accepts (owned first in the local order: a pair
+    // (a, b), a < b, has an owned particle exactly when a is owned), and each owned particle's row of
+    // partners sorted by id.
+    void find_pairs()
+    {
+        const std::size_t n = p_.size(), no = p_.owned();
+        px_.resize(n);
+        py_.resize(n);
+        pz_.resize(n);
+        for (std::size_t l = 0; l < n; ++l) {
+            px_[l] = p_.x[l].x;
+            py_[l] = p_.x[l].y;
+            pz_[l] = p_.x[l].z;
+        }
+        if (n > cells_reserved_) {
+            cells_reserved_ = n + n / 4;
+            cells_.reserve(cells_reserved_);
+        }
+        pairs_.clear();
+        if (n > 0) cells_.build(n, px_.data(), py_.data(), pz_.data(), plan_.cell);
+        for (std::size_t a = 0; a < no; ++a)
+            cells_.for_each_above(a, [&](std::size_t b) {
+                if (!may_touch(p_.x[a], p_.x[b], p_.r[a], p_.r[b])) return;
+                pairs_.push_back(p_.id[a] < p_.id[b] ? Pair{std::int32_t(a), std::int32_t(b)} : Pair{std::int32_t(b), std::int32_t(a)});
+            });
+        row_start_.assign(no + 1, 0);
+        for (const Pair& q : pairs_) {
+            if (std::size_t(q.i) < no) ++row_start_[std::size_t(q.i) + 1];
+            if (std::size_t(q.j) < no) ++row_start_[std::size_t(q.j) + 1];
+        }
+        for (std::size_t l = 0; l < no; ++l) row_start_[l + 1] += row_start_[l];
+        rows_.resize(row_start_[no]);
+        fill_.assign(row_start_.begin(), row_start_.end() - 1);
+        for (std::size_t k = 0; k < pairs_.size(); ++k) {
+            const Pair& q = pairs_[k];
+            if (std::size_t(q.i) < no) rows_[fill_[std::size_t(q.i)]++] = {p_.id[std::size_t(q.j)], std::int32_t(k), true};
+            if (std::size_t(q.j) < no) rows_[fill_[std::size_t(q.j)]++] = {p_.id[std::size_t(q.i)], std::int32_t(k), false};
+        }
+        for (std::size_t l = 0; l < no; ++l)  // a few partners per row: insertion sort
+            for (std::size_t e = row_start_[l] + 1; e < row_start_[l + 1]; ++e)
+                for (std::size_t k = e; k > row_start_[l] && rows_[k - 1].partner > rows_[k].partner; --k) std::swap(rows_[k - 1], rows_[k]);
+    }
+
+    // The walls each owned particle may touch, in wall order.
+    void find_walls()
+    {
+        const std::size_t no = p_.owned();
+        wall_start_.assign(no + 1, 0);
+        wall_rows_.clear();
+        for (std::size_t l = 0; l < no; ++l) {
+            for (std::size_t w = 0; w < walls_.size(); ++w)
+                if (may_touch_wall(p_.x[l], p_.r[l], wp_[w], walls_[w].normal)) wall_rows_.push_back(std::int32_t(w));
+            wall_start_[l + 1] = wall_rows_.size();
+        }
+    }
+
+    Comm comm_;
+    Plan plan_;
+    std::int64_t step_ = 0, steps_ = 0, owned_max_ = 0, migrants_ = 0;
+    double dt_ = 0.0;
+    GearCoefficients<double> coef_;
+    ContactParams<double> params_;
+    Coefficients<double> mono_pp_, mono_pw_;
+    Vec3d g_;
+    std::vector<Wall> walls_;
+    std::vector<Vec3d> wp_;  // the walls' points at the current step
+    RankParticles p_;
+    std::vector<double> down_, up_, from_down_, from_up_;  // exchange buffers, kept between steps
+    std::vector<double> px_, py_, pz_;
+    LinkedCells cells_;
+    std::size_t cells_reserved_ = 0;
+    std::vector<Pair> pairs_;
+    std::vector<Entry> rows_;
+    std::vector<std::size_t> row_start_, fill_, wall_start_;
+    std::vector<std::int32_t> wall_rows_;
+    std::vector<ContactForce<double>> pf_;
+    std::vector<char> live_;
+    std::int64_t pp_ = 0, pw_ = 0, candidates_ = 0;
+};
+
+} // namespace demmat::mpi
