@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <mpi.h>
 
+#include "lockstep.hpp"
 #include "mpi_variant.hpp"
 #include "support.hpp"
 
@@ -38,38 +39,15 @@ struct Lockstep {
 };
 
 // `steps` steps of the mpi variant and (rank 0) arrays, compared after init and after every step; stops
-// at the first difference.
+// at the first difference (lockstep.hpp).
 Lockstep run_lockstep(const std::function<std::unique_ptr<Problem>()>& load, std::int64_t steps, const MpiOptions& options = {})
 {
-    const Comm& comm = world();
     Lockstep out;
-    auto problem = share_problem(comm, load);
+    auto problem = share_problem(world(), load);
     auto mpi = make_mpi_variant(MPI_COMM_WORLD, options);
-    Driver driver(*mpi, problem->setup());
-    std::unique_ptr<VariantRun> ref;
-    if (comm.root()) ref = std::make_unique<VariantRun>("arrays", problem->setup());
-    auto compare = [&] {
-        mpi->snapshot(out.last);
-        int diverged = 0;
-        if (comm.root()) {
-            if (const auto d = first_difference(ref->snapshot(), out.last)) {
-                Difference named = *d;
-                named.variant_a = "arrays";
-                named.variant_b = fmt::format("mpi at {} processes", comm.size());
-                out.difference = named.describe();
-                diverged = 1;
-            }
-        }
-        MPI_Bcast(&diverged, 1, MPI_INT, 0, MPI_COMM_WORLD);
-        return diverged == 0;
-    };
-    bool same = compare();
-    for (std::int64_t k = 1; k <= steps && same; ++k) {
-        driver.step();
-        if (ref) ref->driver->step();
-        same = compare();
-        out.steps = k;
-    }
+    const LockstepResult r = compare_lockstep(*problem, *mpi, registry().find("arrays").create, "arrays", steps, &out.last);
+    if (r.difference) out.difference = r.difference->describe();
+    out.steps = r.steps;
     out.reports = mpi->rank_reports();
     out.counts = mpi->counts();
     out.slabs = mpi->slabs();
