@@ -59,7 +59,7 @@ Plan share_plan(const Comm& comm, const Setup& setup, const MpiOptions& options)
         data = plan_to_doubles(p);
     }
     comm.broadcast(failure);
-    if (!failure.empty()) throw Error(failure);
+    if (!failure.empty()) throw AllRanksError(failure);
     comm.broadcast(data);
     return plan_from_doubles(data);
 }
@@ -88,7 +88,13 @@ public:
     std::size_t memory_bytes() const override { return impl_ ? impl_->memory_bytes() : 0; }
     ModelFeatures model() const override { return impl_ ? impl_->model() : ModelFeatures::full(); }
     const Comm& comm() const override { return impl_ ? impl_->comm() : comm_; }
-    std::vector<RankReport> rank_reports() const override { return impl_->rank_reports(); }
+    RankReport local_report() const override
+    {
+        if (impl_) return impl_->local_report();
+        RankReport r;
+        r.rank = comm_.rank();
+        return r;
+    }
     double communicate_seconds() const override { return impl_ ? impl_->communicate_seconds() : 0.0; }
     const Slabs& slabs() const override { return impl_->slabs(); }
 
@@ -99,6 +105,19 @@ private:
 };
 
 } // namespace
+
+std::vector<RankReport> MpiVariant::rank_reports() const
+{
+    const RankReport me = local_report();
+    const std::vector<double> mine = {double(me.rank), double(me.owned), double(me.ghosts), double(me.owned_max), double(me.steps),
+                                      double(me.migrants), double(me.traffic.messages), double(me.traffic.bytes), me.traffic.seconds};
+    const std::vector<double> all = comm().gather(mine);
+    std::vector<RankReport> out;
+    for (std::size_t k = 0; k + 9 <= all.size(); k += 9)
+        out.push_back({int(all[k]), std::int64_t(all[k + 1]), std::int64_t(all[k + 2]), std::int64_t(all[k + 3]), std::int64_t(all[k + 4]),
+                       std::int64_t(all[k + 5]), Traffic{std::int64_t(all[k + 6]), std::int64_t(all[k + 7]), all[k + 8]}});
+    return out;
+}
 
 std::unique_ptr<MpiVariant> make_mpi_variant(MPI_Comm comm, const MpiOptions& options)
 {

@@ -14,6 +14,7 @@
 
 #include "comm.hpp"
 #include "slabs.hpp"
+#include "demmat/error.hpp"
 #include "demmat/problem.hpp"
 #include "demmat/variant.hpp"
 
@@ -32,11 +33,20 @@ struct RankReport {
     Traffic traffic;                                     // sent to neighbours since init (migrants and ghosts)
 };
 
+// An error every rank throws at once (bad input found by rank 0 and sent to all, a process count the
+// scene cannot be split into): the program prints it once and every rank exits normally, non-zero.
+class AllRanksError : public Error {
+public:
+    using Error::Error;
+};
+
 class MpiVariant : public Variant {
 public:
     virtual const Comm& comm() const = 0;
+    // This rank's report (not collective).
+    virtual RankReport local_report() const = 0;
     // Rank 0 gets every rank's report, in rank order; the others an empty vector. Collective.
-    virtual std::vector<RankReport> rank_reports() const = 0;
+    std::vector<RankReport> rank_reports() const;
     // This rank's seconds spent exchanging with its neighbours (inside the search phase) since init.
     virtual double communicate_seconds() const = 0;
     virtual const Slabs& slabs() const = 0;
@@ -46,8 +56,8 @@ std::unique_ptr<MpiVariant> make_mpi_variant(MPI_Comm comm, const MpiOptions& op
 
 // The problem on every rank, from rank 0's: rank 0 calls `load` (reading the scene and its state);
 // every other rank gets the scene (sent as its TOML text, without the particles) and a state with no
-// particles that holds the step, the fingerprint and the walls. If `load` throws an Error on rank 0,
-// every rank throws it (the message is sent), so that all exit together. Collective.
+// particles that holds the step, the fingerprint and the walls. If `load` throws on rank 0, every rank
+// throws its message as an AllRanksError, so that all exit together. Collective.
 std::unique_ptr<Problem> share_problem(const Comm& comm, const std::function<std::unique_ptr<Problem>()>& load);
 
 } // namespace demmat::mpi

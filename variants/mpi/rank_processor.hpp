@@ -232,17 +232,9 @@ public:
     const Comm& comm() const override { return comm_; }
     double communicate_seconds() const override { return comm_.traffic().seconds; }
     const Slabs& slabs() const override { return plan_.slabs; }
-    std::vector<RankReport> rank_reports() const override
+    RankReport local_report() const override
     {
-        const Traffic& tr = comm_.traffic();
-        const std::vector<double> mine = {double(comm_.rank()), double(p_.owned()), double(p_.size() - p_.owned()), double(owned_max_),
-                                          double(steps_), double(migrants_), double(tr.messages), double(tr.bytes), tr.seconds};
-        const std::vector<double> all = comm_.gather(mine);
-        std::vector<RankReport> out;
-        for (std::size_t k = 0; k + 9 <= all.size(); k += 9)
-            out.push_back({int(all[k]), std::int64_t(all[k + 1]), std::int64_t(all[k + 2]), std::int64_t(all[k + 3]), std::int64_t(all[k + 4]),
-                           std::int64_t(all[k + 5]), Traffic{std::int64_t(all[k + 6]), std::int64_t(all[k + 7]), all[k + 8]}});
-        return out;
+        return {comm_.rank(), std::int64_t(p_.owned()), std::int64_t(p_.size() - p_.owned()), owned_max_, steps_, migrants_, comm_.traffic()};
     }
 
 private:

@@ -71,7 +71,7 @@ std::unique_ptr<Problem> share_problem(const Comm& comm, const std::function<std
         }
     }
     comm.broadcast(failure);
-    if (!failure.empty()) throw Error(failure);
+    if (!failure.empty()) throw AllRanksError(failure);
     comm.broadcast(text);
     comm.broadcast(names);
     comm.broadcast(head);
