@@ -31,3 +31,10 @@ demmat_mpi_test(mpi.equivalence.np8 8 "MpiEquivalence.*" LONG)
 foreach(r 1 2 3 4 8)
   demmat_mpi_test(mpi.equivalence_long.np${r} ${r} "MpiEquivalenceLong.*" LONG)
 endforeach()
+
+# demmat_mpi's command line: bad input, compare, save at 3 and continue at 2 (check_cli.sh).
+if(TARGET demmat_mpi)
+  add_test(NAME mpi.cli COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/mpi/check_cli.sh $<TARGET_FILE:demmat> $<TARGET_FILE:demmat_mpi>
+                                  ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/mpi_cli_work ${DEMMAT_MPIRUN})
+  set_tests_properties(mpi.cli PROPERTIES TIMEOUT 300 PROCESSORS 3)
+endif()
