@@ -32,7 +32,13 @@ def samples(work):
     for path in sorted(glob.glob(os.path.join(work, "mpi*_n*_r*.json"))):
         r = results.load(path)
         n, rep = map(int, re.search(r"_n(\d+)_r(\d+)\.json$", path).groups())
-        rows.append({"N": n, "config": f"mpi R={r.meta['processes']}", "repetition": rep, "us": r.meta["us_per_particle_step"]})
+        t = r.table
+        compute = t[t.phase != "communicate"].groupby("rank")["seconds"].sum()
+        ranks = t[t.phase == "predict"]
+        rows.append({"N": n, "config": f"mpi R={r.meta['processes']}", "repetition": rep, "us": r.meta["us_per_particle_step"],
+                     # the slowest rank's compute (every phase but communicate), the ranks' mean communicate, per step
+                     "compute_s": compute.max(), "communicate_s": t[t.phase == "communicate"]["seconds"].mean(),
+                     "ghosts_mean": ranks["ghosts"].mean()})
         prov = prov or r.provenance
     for path in sorted(glob.glob(os.path.join(work, "fast_n*_r*.json"))):
         r = results.load(path)
@@ -60,7 +66,8 @@ def halo(work):
                      "ghosts_mean": t["ghosts"].mean(), "ghosts_max": t["ghosts"].max(),
                      "messages_per_step_mean": t["messages_per_step"].mean(), "messages_per_step_max": t["messages_per_step"].max(),
                      "bytes_per_step_mean": t["bytes_per_step"].mean(), "bytes_per_step_max": t["bytes_per_step"].max(),
-                     "axis": r.meta["decomposition"]["axis"]})
+                     "axis": r.meta["decomposition"]["axis"], "face_area_m2": r.meta["decomposition"].get("face_area_m2"),
+                     "halo_m": r.meta["decomposition"].get("halo_m")})
     return pd.DataFrame(rows).sort_values(["N", "R"]) if rows else pd.DataFrame()
 
 
@@ -80,10 +87,14 @@ def main():
     with open(a.versions) as f:
         versions = json.load(f)
     med = df.groupby(["N", "config"])["us"].agg(["median", "min", "max", "count"]).reset_index()
+    extra = [c for c in ("compute_s", "communicate_s", "ghosts_mean") if c in df]
+    if extra:
+        med = med.merge(df.groupby(["N", "config"])[extra].median().reset_index(), on=["N", "config"], how="left")
     med.to_csv(os.path.join(a.out, "bench_mpi.csv.tmp"), index=False)
     os.replace(os.path.join(a.out, "bench_mpi.csv.tmp"), os.path.join(a.out, "bench_mpi.csv"))
     write_text(os.path.join(a.out, "bench_mpi.json"), json.dumps(
-        {"provenance": prov, "peers": versions, "summary": med.to_dict("records"), "samples": df.to_dict("records")}, indent=2) + "\n")
+        {"provenance": prov, "peers": versions, "summary": med.where(med.notna(), None).to_dict("records"),
+         "samples": df.where(df.notna(), None).to_dict("records")}, indent=2) + "\n")
 
     md = ["# The mpi variant against fast and LAMMPS (scripts/run_mpi_bench.sh)", "",
           f"Suite: {results.provenance_line(prov)}. MPI: {versions.get('mpi', '?')}; LAMMPS package {versions.get('lammps_package') or 'absent'}.",

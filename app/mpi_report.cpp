@@ -106,7 +106,8 @@ nlohmann::json report_json(const RunReport& r, const MpiVariant& v)
                                                {"forces", q.per_step.forces}, {"correct", q.per_step.correct}, {"total", q.total()}}}});
     const Slabs& s = v.slabs();
     std::vector<double> cuts(s.cuts.begin() + 1, s.cuts.end() - 1);  // the interior planes (the ends are infinite)
-    return {{"processes", r.ranks.size()}, {"axis", std::string(1, "xyz"[s.axis])}, {"cuts", cuts}, {"steps", r.steps},
+    return {{"processes", r.ranks.size()}, {"axis", std::string(1, "xyz"[s.axis])}, {"cuts", cuts}, {"face_area_m2", s.face_area},
+            {"halo_m", v.halo()}, {"steps", r.steps},
             {"seconds_per_step_slowest_rank", r.total()}, {"ranks", ranks}};
 }
 

@@ -6,7 +6,8 @@
 #   LAMMPS on 2 processes (mpirun -np 2 lmp) on the same particles and law (demmat export-lammps),
 # each a median of µs per particle-step; then the halo traffic (messages and bytes per step per rank,
 # ghosts per rank) of mpi at R = 2 and 4 for every N of --halo-n, measured on the dense bed's lattice
-# (a few steps from t = 0: the counts, not the times, are what is kept). Results in results/mpi/.
+# (a few steps from t = 0: the counts, not the times, are what is kept); then the scaling model of
+# docs/scaling.md from these measurements (analysis/mpi_scaling.py). Results in results/mpi/.
 # Usage: scripts/run_mpi_bench.sh [--n "100000"] [--halo-n "10000 100000 1000000"] [--steps K] [--repetitions R]
 #                                 [--settle-time T] [--out DIR] [--build-dir DIR]
 #   default          N = 10^5; 200 steps, 5 repetitions; halo at N = 10^4, 10^5, 10^6; beds settled 0.4 s
@@ -111,3 +112,6 @@ versions="$work/versions.json"
   echo "}"
 } > "$versions"
 $PYTHON analysis/mpi_bench.py --work "$work" --versions "$versions" --out "$out"
+# The model of docs/scaling.md from these measurements (the network's figures are its defaults, cited there).
+[[ -f $out/halo_mpi.csv ]] && $PYTHON analysis/mpi_scaling.py --bench "$out/bench_mpi.json" --halo "$out/halo_mpi.csv" --out "$out"
+echo "$SCRIPT: results in $out"

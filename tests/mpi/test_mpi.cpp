@@ -52,7 +52,7 @@ Lockstep run_lockstep(const std::function<std::unique_ptr<Problem>()>& load, std
     out.counts = mpi->counts();
     out.slabs = mpi->slabs();
     out.particles = problem->size();
-    out.halo = 2.0 * problem->setup().radius_max;
+    out.halo = mpi->halo();
     return out;
 }
 

@@ -17,7 +17,7 @@ std::vector<double> plan_to_doubles(const Plan& p)
 {
     const ModelFeatures& f = p.features;
     std::vector<double> d = {double(f.rotation), double(f.friction), double(f.damping), double(f.walls), double(f.moving_walls),
-                             double(f.polydisperse), double(p.slabs.axis), p.radius_max, p.cell, p.halo, p.r0, p.m0};
+                             double(f.polydisperse), double(p.slabs.axis), p.radius_max, p.cell, p.halo, p.r0, p.m0, p.slabs.face_area};
     d.insert(d.end(), p.slabs.cuts.begin(), p.slabs.cuts.end());
     return d;
 }
@@ -32,7 +32,8 @@ Plan plan_from_doubles(const std::vector<double>& d)
     p.halo = d[9];
     p.r0 = d[10];
     p.m0 = d[11];
-    p.slabs.cuts.assign(d.begin() + 12, d.end());
+    p.slabs.face_area = d[12];
+    p.slabs.cuts.assign(d.begin() + 13, d.end());
     return p;
 }
 
@@ -97,6 +98,7 @@ public:
     }
     double communicate_seconds() const override { return impl_ ? impl_->communicate_seconds() : 0.0; }
     const Slabs& slabs() const override { return impl_->slabs(); }
+    double halo() const override { return impl_->halo(); }
 
 private:
     Comm comm_;

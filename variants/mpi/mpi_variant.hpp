@@ -50,6 +50,7 @@ public:
     // This rank's seconds spent exchanging with its neighbours (inside the search phase) since init.
     virtual double communicate_seconds() const = 0;
     virtual const Slabs& slabs() const = 0;
+    virtual double halo() const = 0;  // m: ghosts are the particles within this distance of a shared face
 };
 
 std::unique_ptr<MpiVariant> make_mpi_variant(MPI_Comm comm, const MpiOptions& options = {});

@@ -232,6 +232,7 @@ public:
     const Comm& comm() const override { return comm_; }
     double communicate_seconds() const override { return comm_.traffic().seconds; }
     const Slabs& slabs() const override { return plan_.slabs; }
+    double halo() const override { return plan_.halo; }
     RankReport local_report() const override
     {
         return {comm_.rank(), std::int64_t(p_.owned()), std::int64_t(p_.size() - p_.owned()), owned_max_, steps_, migrants_, comm_.traffic()};

@@ -24,6 +24,7 @@ enum class Balance { count, even };
 struct Slabs {
     int axis = 0;               // 0, 1, 2: x, y, z
     std::vector<double> cuts;   // R + 1 planes; cuts[0] = −∞, cuts[R] = +∞
+    double face_area = 0.0;     // m²: the particles' bounding box across the axis at init (a face's area)
 
     int ranks() const { return int(cuts.size()) - 1; }
     // The rank that owns coordinate c: the last r with cuts[r] <= c (a NaN goes to the last rank; the health
@@ -73,6 +74,18 @@ inline std::string plan_slabs(const std::vector<Vec3d>& x, int ranks, double ran
     c.reserve(x.size());
     for (const Vec3d& p : x) c.push_back(component(p, out.axis));
     std::sort(c.begin(), c.end());
+    {
+        double span[3] = {0.0, 0.0, 0.0};
+        for (int k = 0; k < 3; ++k) {
+            double a = std::numeric_limits<double>::infinity(), b = -a;
+            for (const Vec3d& p : x) {
+                a = std::min(a, component(p, k));
+                b = std::max(b, component(p, k));
+            }
+            span[k] = x.empty() ? 0.0 : b - a;
+        }
+        out.face_area = span[(out.axis + 1) % 3] * span[(out.axis + 2) % 3];
+    }
     const double lo = c.empty() ? 0.0 : c.front(), hi = c.empty() ? 0.0 : c.back();
     auto make = [&](Balance b) {
         out.cuts.assign(std::size_t(ranks) + 1, 0.0);
