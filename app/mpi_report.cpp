@@ -25,7 +25,8 @@ RunReport gather_report(const MpiVariant& v, const Driver& d, std::int64_t steps
     const double comm = (now.report.traffic.seconds - b.report.traffic.seconds) * k;
     const RankReport& r = now.report;
     const std::vector<double> mine = {double(r.rank), double(r.owned), double(r.ghosts), double(r.owned_max), double(steps),
-                                      double(r.migrants - b.report.migrants), double(r.traffic.messages - b.report.traffic.messages),
+                                      double(r.migrants - b.report.migrants), double(r.rebuilds - b.report.rebuilds),
+                                      double(r.traffic.messages - b.report.traffic.messages),
                                       double(r.traffic.bytes - b.report.traffic.bytes), comm, t.predict, t.search - comm, t.forces, t.correct};
     const std::vector<double> all = v.comm().gather(mine);
     RunReport out;
@@ -35,9 +36,9 @@ RunReport gather_report(const MpiVariant& v, const Driver& d, std::int64_t steps
         const double* q = &all[i];
         RankShare s;
         s.report = {int(q[0]), std::int64_t(q[1]), std::int64_t(q[2]), std::int64_t(q[3]), std::int64_t(q[4]), std::int64_t(q[5]),
-                    Traffic{std::int64_t(q[6]), std::int64_t(q[7]), q[8]}};
-        s.communicate = q[8];
-        s.per_step = {q[9], q[10], q[11], q[12]};
+                    std::int64_t(q[6]), Traffic{std::int64_t(q[7]), std::int64_t(q[8]), q[9]}};
+        s.communicate = q[9];
+        s.per_step = {q[10], q[11], q[12], q[13]};
         out.ranks.push_back(s);
     }
     return out;
@@ -87,8 +88,10 @@ void print_report(std::ostream& out, const RunReport& r, double particles)
     const Spread msg = spread(r, [](const RankShare& q) { return per_step(q, q.report.traffic.messages); });
     const Spread bytes = spread(r, [](const RankShare& q) { return per_step(q, q.report.traffic.bytes); });
     const Spread mig = spread(r, [](const RankShare& q) { return per_step(q, q.report.migrants); });
-    out << fmt::format("halo per step per rank (ghosts and migrants sent): messages mean {:.2f} max {:.0f}  bytes mean {:.0f} max {:.0f}  "
-                       "migrants mean {:.3f}\n", msg.mean, msg.max, bytes.mean, bytes.max, mig.mean);
+    const double rebuilds = r.ranks.empty() ? 0.0 : per_step(r.ranks[0], r.ranks[0].report.rebuilds);
+    out << fmt::format("halo per step per rank (ghosts and migrants sent): messages mean {:.2f} max {:.2f}  bytes mean {:.0f} max {:.0f}  "
+                       "migrants mean {:.3f}  (neighbour list rebuilt at {:.3f} of the steps)\n", msg.mean, msg.max, bytes.mean, bytes.max,
+                       mig.mean, rebuilds);
 }
 
 nlohmann::json report_json(const RunReport& r, const MpiVariant& v)
@@ -102,6 +105,7 @@ nlohmann::json report_json(const RunReport& r, const MpiVariant& v)
                          {"messages_per_step", per_step(q, q.report.traffic.messages)},
                          {"bytes_per_step", per_step(q, q.report.traffic.bytes)},
                          {"migrants_per_step", per_step(q, q.report.migrants)},
+                         {"rebuilds_per_step", per_step(q, q.report.rebuilds)},
                          {"seconds_per_step", {{"predict", q.per_step.predict}, {"communicate", q.communicate}, {"search", q.per_step.search},
                                                {"forces", q.per_step.forces}, {"correct", q.per_step.correct}, {"total", q.total()}}}});
     const Slabs& s = v.slabs();

@@ -96,6 +96,15 @@ std::int64_t Comm::sum(std::int64_t v) const
     return out;
 }
 
+bool Comm::any(bool flag)
+{
+    const auto t0 = std::chrono::steady_clock::now();
+    int in = flag ? 1 : 0, out = 0;
+    MPI_Allreduce(&in, &out, 1, MPI_INT, MPI_MAX, comm_);
+    traffic_.seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return out != 0;
+}
+
 double Comm::max(double v) const
 {
     double out = 0.0;

@@ -42,6 +42,8 @@ public:
     void broadcast(std::vector<double>& data) const;  // from rank 0; resized on the others
     void broadcast(std::string& text) const;
     std::int64_t sum(std::int64_t v) const;
+    // True on every rank when `flag` is on some rank; timed into traffic().seconds (it is a step's exchange).
+    bool any(bool flag);
     double max(double v) const;
 
 private:

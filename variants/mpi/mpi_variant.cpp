@@ -2,6 +2,8 @@
 // the instantiation for that model (with_model, as the specialising variants pick theirs).
 #include "mpi_variant.hpp"
 
+#include <algorithm>
+
 #include "rank_processor.hpp"
 #include "demmat/features.hpp"
 
@@ -12,12 +14,14 @@ namespace {
 // The largest distance at which two grains can touch is 2·R_max; the halo's relative margin covers the
 // rounding of a coordinate's distance to a face (about 1e-16 relative), so no contact is missed.
 constexpr double kHaloMargin = 1.000001;
+// The neighbour list's skin in units of R_max, fast's default (variants/fast/fast.hpp).
+constexpr double kSkin = 0.3;
 
 std::vector<double> plan_to_doubles(const Plan& p)
 {
     const ModelFeatures& f = p.features;
     std::vector<double> d = {double(f.rotation), double(f.friction), double(f.damping), double(f.walls), double(f.moving_walls),
-                             double(f.polydisperse), double(p.slabs.axis), p.radius_max, p.cell, p.halo, p.r0, p.m0, p.slabs.face_area};
+                             double(f.polydisperse), double(p.slabs.axis), p.radius_max, p.cell, p.halo, p.r0, p.m0, p.slabs.face_area, p.skin};
     d.insert(d.end(), p.slabs.cuts.begin(), p.slabs.cuts.end());
     return d;
 }
@@ -33,7 +37,8 @@ Plan plan_from_doubles(const std::vector<double>& d)
     p.r0 = d[10];
     p.m0 = d[11];
     p.slabs.face_area = d[12];
-    p.slabs.cuts.assign(d.begin() + 13, d.end());
+    p.skin = d[13];
+    p.slabs.cuts.assign(d.begin() + 14, d.end());
     return p;
 }
 
@@ -48,10 +53,11 @@ Plan share_plan(const Comm& comm, const Setup& setup, const MpiOptions& options)
         Plan p;
         p.features = model_for(setup);
         p.radius_max = setup.radius_max;
-        p.halo = 2.0 * setup.radius_max * kHaloMargin;
-        // The scene's cells when it asks for cells (wider ones only add candidates), else cells of 2·R_max:
-        // the search never changes the contact set (physics.md §5), so neither does this choice.
-        p.cell = setup.cell_size > 0.0 ? setup.cell_size : 2.0 * setup.radius_max;
+        p.skin = kSkin * setup.radius_max;
+        p.halo = (2.0 * setup.radius_max + p.skin) * kHaloMargin;
+        // Cells as wide as the longest listed pair, or the scene's if wider (they only add candidates): the
+        // search never changes the contact set (physics.md §5), so neither does this choice.
+        p.cell = std::max(setup.cell_size, 2.0 * setup.radius_max) + p.skin;
         if (s.size() > 0) {
             p.r0 = s.radius[0];
             p.m0 = setup.mass[0];
@@ -112,12 +118,13 @@ std::vector<RankReport> MpiVariant::rank_reports() const
 {
     const RankReport me = local_report();
     const std::vector<double> mine = {double(me.rank), double(me.owned), double(me.ghosts), double(me.owned_max), double(me.steps),
-                                      double(me.migrants), double(me.traffic.messages), double(me.traffic.bytes), me.traffic.seconds};
+                                      double(me.migrants), double(me.rebuilds), double(me.traffic.messages), double(me.traffic.bytes),
+                                      me.traffic.seconds};
     const std::vector<double> all = comm().gather(mine);
     std::vector<RankReport> out;
-    for (std::size_t k = 0; k + 9 <= all.size(); k += 9)
+    for (std::size_t k = 0; k + 10 <= all.size(); k += 10)
         out.push_back({int(all[k]), std::int64_t(all[k + 1]), std::int64_t(all[k + 2]), std::int64_t(all[k + 3]), std::int64_t(all[k + 4]),
-                       std::int64_t(all[k + 5]), Traffic{std::int64_t(all[k + 6]), std::int64_t(all[k + 7]), all[k + 8]}});
+                       std::int64_t(all[k + 5]), std::int64_t(all[k + 6]), Traffic{std::int64_t(all[k + 7]), std::int64_t(all[k + 8]), all[k + 9]}});
     return out;
 }
 

@@ -30,6 +30,7 @@ struct RankReport {
     std::int64_t owned = 0, ghosts = 0, owned_max = 0;  // owned_max: the most it owned after any step
     std::int64_t steps = 0;                              // steps taken since init
     std::int64_t migrants = 0;                           // particles it handed to a neighbour since init
+    std::int64_t rebuilds = 0;                           // neighbour-list rebuilds since init (every rank alike)
     Traffic traffic;                                     // sent to neighbours since init (migrants and ghosts)
 };
 

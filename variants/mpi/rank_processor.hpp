@@ -3,10 +3,15 @@
 //
 //   predict  the Gear predictor on the owned particles; moving walls placed from the step number (every
 //            rank computes the same wall positions, nothing is sent for them)
-//   search   communicate: owned particles that left the slab migrate to the neighbour (with their
-//            whole Gear history), then each rank sends its neighbours ghost copies of its particles
-//            within the interaction range of the shared face; then the cell search over owned and
-//            ghosts keeps every pair with an owned particle that may_touch accepts
+//   search   a neighbour list with a skin, as fast keeps one: rebuilt when some particle on some rank
+//            has moved more than 0.45 skin since the last rebuild (one allreduce of a flag per step).
+//            At a rebuild, communicate: owned particles that left the slab migrate to the neighbour (with
+//            their whole Gear history), then each rank sends its neighbours ghost copies of its particles
+//            within the interaction range plus the skin of the shared face, and remembers whom it sent;
+//            the cell search over owned and ghosts lists every pair with an owned particle closer than
+//            R_i + R_j + skin. Between rebuilds, communicate only refreshes the ghosts (position,
+//            velocity, angular velocity of the same particles, in the same order). A particle moves
+//            less than half the skin between rebuilds, so the list holds every contact (the law decides)
 //   forces   each pair's force once per rank, by the shared law with the lower id as i; each owned
 //            particle's sum in the canonical order (partners ascending by id, then walls in order)
 //   correct  the Gear corrector on the owned particles
@@ -36,7 +41,8 @@ struct Plan {
     Slabs slabs;
     double radius_max = 0.0;
     double cell = 0.0;   // edge of the search's cells
-    double halo = 0.0;   // ghosts: particles within this distance of a shared face
+    double skin = 0.0;   // the neighbour list's skin
+    double halo = 0.0;   // ghosts: particles within this distance of a shared face (contact range + skin)
     double r0 = 0.0, m0 = 0.0;  // particle 0's radius and mass (a monodisperse model's coefficients)
 };
 
@@ -82,6 +88,8 @@ public:
         owned_max_ = std::int64_t(p_.owned());
         steps_ = 0;
         migrants_ = 0;
+        rebuilds_ = 0;
+        built_ = false;
     }
 
     void predict(std::int64_t step) override
@@ -101,10 +109,17 @@ public:
 
     void search() override
     {
-        migrate();
-        exchange_ghosts();
-        find_pairs();
-        if constexpr (M::walls) find_walls();
+        if (!built_ || must_rebuild()) {
+            migrate();
+            exchange_ghosts();
+            find_pairs();
+            x_built_.assign(p_.x.begin(), p_.x.begin() + std::ptrdiff_t(p_.owned()));
+            built_ = true;
+            ++rebuilds_;
+        } else {
+            refresh_ghosts();
+        }
+        if constexpr (M::walls) find_walls();  // every step, without a skin: a wall may move
         ++steps_;
         owned_max_ = std::max(owned_max_, std::int64_t(p_.owned()));
     }
@@ -235,7 +250,8 @@ public:
     double halo() const override { return plan_.halo; }
     RankReport local_report() const override
     {
-        return {comm_.rank(), std::int64_t(p_.owned()), std::int64_t(p_.size() - p_.owned()), owned_max_, steps_, migrants_, comm_.traffic()};
+        return {comm_.rank(), std::int64_t(p_.owned()), std::int64_t(p_.size() - p_.owned()), owned_max_, steps_, migrants_, rebuilds_,
+                comm_.traffic()};
     }
 
 private:
@@ -287,14 +303,63 @@ private:
         up_.clear();
         const int me = comm_.rank();
         const double lo = plan_.slabs.cuts[std::size_t(me)], hi = plan_.slabs.cuts[std::size_t(me) + 1];
+        send_down_.clear();
+        send_up_.clear();
         for (std::size_t l = 0; l < p_.owned(); ++l) {
             const double c = axis_coordinate(l);
-            if (me > 0 && c - lo < plan_.halo) p_.pack_ghost(l, down_);
-            if (me + 1 < comm_.size() && hi - c < plan_.halo) p_.pack_ghost(l, up_);
+            if (me > 0 && c - lo < plan_.halo) {
+                p_.pack_ghost(l, down_);
+                send_down_.push_back(std::int32_t(l));
+            }
+            if (me + 1 < comm_.size() && hi - c < plan_.halo) {
+                p_.pack_ghost(l, up_);
+                send_up_.push_back(std::int32_t(l));
+            }
         }
         comm_.exchange(down_, up_, from_down_, from_up_, 2);
         p_.add_ghosts(from_down_);
         p_.add_ghosts(from_up_);
+        ghosts_from_down_ = from_down_.size() / kGhostDoubles;
+        ghosts_from_up_ = from_up_.size() / kGhostDoubles;
+    }
+
+    // Between rebuilds: the same particles' position, velocity and angular velocity, in the order of the
+    // rebuild, overwrite the ghosts they made.
+    void refresh_ghosts()
+    {
+        auto pack = [&](const std::vector<std::int32_t>& list, std::vector<double>& out) {
+            out.clear();
+            for (std::int32_t l : list)
+                for (const Vec3d* q : {&p_.x[std::size_t(l)], &p_.v[std::size_t(l)], &p_.w[std::size_t(l)]})
+                    for (int c = 0; c < 3; ++c) out.push_back(component(*q, c));
+        };
+        pack(send_down_, down_);
+        pack(send_up_, up_);
+        comm_.exchange(down_, up_, from_down_, from_up_, 3);
+        auto unpack = [&](const std::vector<double>& in, std::size_t count, std::size_t first) {
+            if (in.size() != 9 * count) throw Error("internal: a neighbour refreshed a different number of ghosts");
+            for (std::size_t k = 0; k < count; ++k) {
+                const double* q = &in[9 * k];
+                p_.x[first + k] = {q[0], q[1], q[2]};
+                p_.v[first + k] = {q[3], q[4], q[5]};
+                p_.w[first + k] = {q[6], q[7], q[8]};
+            }
+        };
+        unpack(from_down_, ghosts_from_down_, p_.owned());
+        unpack(from_up_, ghosts_from_up_, p_.owned() + ghosts_from_down_);
+    }
+
+    // Has any particle on any rank moved more than 0.45 skin since the last rebuild (fast's criterion)?
+    bool must_rebuild()
+    {
+        double worst = 0.0;
+        for (std::size_t l = 0; l < p_.owned(); ++l) {
+            const Vec3d d = p_.x[l] - x_built_[l];
+            worst = std::max(worst, dot(d, d));
+        }
+        const double limit = 0.45 * plan_.skin;
+        // A NaN position compares false: rebuild, so that the cell search names the particle.
+        return comm_.any(!(worst <= limit * limit));
     }
 
     // Every pair with an owned particle that may_touch accepts (owned first in the local order: a pair
@@ -316,10 +381,11 @@ private:
             cells_.reserve(cells_reserved_);
         }
         pairs_.clear();
+        const double half_skin = 0.5 * plan_.skin;  // may_touch with each radius grown: pairs closer than R_i + R_j + skin
         if (n > 0) cells_.build(n, px_.data(), py_.data(), pz_.data(), plan_.cell);
         for (std::size_t a = 0; a < no; ++a)
             cells_.for_each_above(a, [&](std::size_t b) {
-                if (!may_touch(p_.x[a], p_.x[b], p_.r[a], p_.r[b])) return;
+                if (!may_touch(p_.x[a], p_.x[b], p_.r[a] + half_skin, p_.r[b] + half_skin)) return;
                 pairs_.push_back(p_.id[a] < p_.id[b] ? Pair{std::int32_t(a), std::int32_t(b)} : Pair{std::int32_t(b), std::int32_t(a)});
             });
         row_start_.assign(no + 1, 0);
@@ -355,7 +421,11 @@ private:
 
     Comm comm_;
     Plan plan_;
-    std::int64_t step_ = 0, steps_ = 0, owned_max_ = 0, migrants_ = 0;
+    std::int64_t step_ = 0, steps_ = 0, owned_max_ = 0, migrants_ = 0, rebuilds_ = 0;
+    bool built_ = false;
+    std::vector<Vec3d> x_built_;                         // owned positions at the last rebuild
+    std::vector<std::int32_t> send_down_, send_up_;      // the owned particles whose ghosts the neighbours hold
+    std::size_t ghosts_from_down_ = 0, ghosts_from_up_ = 0;
     double dt_ = 0.0;
     GearCoefficients<double> coef_;
     ContactParams<double> params_;
