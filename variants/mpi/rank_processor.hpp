@@ -96,13 +96,11 @@ public:
     {
         step_ = step;
         for (std::size_t l = 0; l < p_.owned(); ++l) {
-            for (int c = 0; c < 3; ++c)
-                Gear5Scheme::predict(component(p_.x[l], c), component(p_.v[l], c), component(p_.a[l], c), component(p_.b3[l], c),
-                                     component(p_.b4[l], c), component(p_.b5[l], c), coef_);
-            if constexpr (M::rotation)
-                for (int c = 0; c < 3; ++c)
-                    Gear5Scheme::predict(component(p_.th[l], c), component(p_.w[l], c), component(p_.al[l], c),
-                                         component(p_.q3[l], c), component(p_.q4[l], c), component(p_.q5[l], c), coef_);
+            each_component([&](auto c) {
+                Gear5Scheme::predict(c(p_.x[l]), c(p_.v[l]), c(p_.a[l]), c(p_.b3[l]), c(p_.b4[l]), c(p_.b5[l]), coef_);
+                if constexpr (M::rotation)
+                    Gear5Scheme::predict(c(p_.th[l]), c(p_.w[l]), c(p_.al[l]), c(p_.q3[l]), c(p_.q4[l]), c(p_.q5[l]), coef_);
+            });
         }
         if constexpr (M::moving_walls) place_walls(step);
     }
@@ -177,14 +175,11 @@ public:
     void correct() override
     {
         for (std::size_t l = 0; l < p_.owned(); ++l) {
-            for (int c = 0; c < 3; ++c)
-                Gear5Scheme::correct(component(p_.x[l], c), component(p_.v[l], c), component(p_.a[l], c), component(p_.b3[l], c),
-                                     component(p_.b4[l], c), component(p_.b5[l], c), component(p_.acc[l], c), coef_);
-            if constexpr (M::rotation)
-                for (int c = 0; c < 3; ++c)
-                    Gear5Scheme::correct(component(p_.th[l], c), component(p_.w[l], c), component(p_.al[l], c),
-                                         component(p_.q3[l], c), component(p_.q4[l], c), component(p_.q5[l], c),
-                                         component(p_.alc[l], c), coef_);
+            each_component([&](auto c) {
+                Gear5Scheme::correct(c(p_.x[l]), c(p_.v[l]), c(p_.a[l]), c(p_.b3[l]), c(p_.b4[l]), c(p_.b5[l]), c(p_.acc[l]), coef_);
+                if constexpr (M::rotation)
+                    Gear5Scheme::correct(c(p_.th[l]), c(p_.w[l]), c(p_.al[l]), c(p_.q3[l]), c(p_.q4[l]), c(p_.q5[l]), c(p_.alc[l]), coef_);
+            });
         }
     }
 
@@ -263,6 +258,15 @@ private:
         std::int32_t pair;
         bool lower;            // this particle is the pair's i (the lower id)
     };
+
+    // f(c) for the three components, c(v) being v.x, v.y or v.z (no run-time branch per value).
+    template <class F>
+    static void each_component(F&& f)
+    {
+        f([](auto& v) -> auto& { return v.x; });
+        f([](auto& v) -> auto& { return v.y; });
+        f([](auto& v) -> auto& { return v.z; });
+    }
 
     void place_walls(std::int64_t step)
     {
