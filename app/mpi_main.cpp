@@ -75,9 +75,6 @@ std::unique_ptr<Problem> load_checked(const Comm& comm, const Args& a, const std
         if (!a.save_file.empty()) check_output_path(a.save_file, "--save", inputs);
         if (!a.json_file.empty() && !a.save_file.empty() && same_file(a.json_file, a.save_file))
             throw Error(fmt::format("--json and --save name the same file {}", a.json_file));
-        if (!scene.contact_model.is_paper())
-            throw Error(fmt::format("the mpi variant computes the paper's contact law only, not {} (the arrays variant runs the laws "
-                                    "of physics.md §9)", scene.contact_model.describe()));
         if (!scene.integrator.is_default())
             throw Error(fmt::format("the mpi variant integrates with gear5 in double only, not {}", scene.integrator.describe()));
         auto p = std::make_unique<Problem>(std::move(scene));

@@ -3,7 +3,7 @@
 # than the interaction range, another variant, a subcommand that stays with demmat) gets one line from
 # rank 0 and a non-zero exit on every rank; compare finds arrays and mpi identical; a state saved at
 # R = 3 and continued at R = 2 (a new stage: the compression wall moves) is the state arrays writes,
-# byte for byte.
+# byte for byte, under the paper's law and under a law with memory (the stretches saved and reloaded).
 # Usage: check_cli.sh DEMMAT DEMMAT_MPI SOURCE_DIR WORK MPIRUN...
 set -eu
 demmat=$1 demmat_mpi=$2 src=$3 work=$4
@@ -40,5 +40,18 @@ cmp a1.state m1.state || fail "the state saved at 3 processes differs from array
 run_np 2 "$demmat_mpi" run cm.toml --steps 300 --save m2.state --json m2.json -q >m2.txt
 cmp a2.state m2.state || fail "continued at 2 processes, the state differs from arrays'"
 grep -q '"communicate"' m2.json || fail "--json has no communicate time"
+
+# The same under a law with memory (physics.md §9): the states carry every live contact's stretches.
+"$demmat" scene dense-bed --n 2000 --contact damping=tsuji --contact restitution=0.5 --contact tangential=mindlin \
+    --contact tangential_damping_ratio=0.5 --contact rolling=sds --contact kr=50 --contact rolling_damping=0.05 \
+    --contact rolling_friction=0.1 -o law.toml
+"$demmat" run law.toml --steps 300 --save la1.state -q >/dev/null
+run_np 3 "$demmat_mpi" run law.toml --steps 300 --save lm1.state -q >/dev/null
+cmp la1.state lm1.state || fail "under a law with memory, the state saved at 3 processes differs from arrays'"
+"$demmat" scene compression --from law.toml --state la1.state -o lca.toml
+"$demmat" scene compression --from law.toml --state lm1.state -o lcm.toml
+"$demmat" run lca.toml --steps 300 --save la2.state -q >/dev/null
+run_np 2 "$demmat_mpi" run lcm.toml --steps 300 --save lm2.state -q >/dev/null
+cmp la2.state lm2.state || fail "under a law with memory, continued at 2 processes, the state differs from arrays'"
 grep -q "^particles per rank max" m2.txt || fail "run reports no particles per rank"
 echo "check_cli: all passed"

@@ -80,11 +80,17 @@ public:
     void init(const Setup& setup) override
     {
         const Plan plan = share_plan(comm_, setup, options_);
-        impl_ = with_model(plan.features, [&]<class M>() -> std::unique_ptr<MpiVariant> {
+        ModelFeatures need = plan.features;  // the law's flags come from the scene, which every rank has
+        const ModelFeatures law = law_features(setup.scene->contact_model);
+        need.restitution_damping = law.restitution_damping;
+        need.history = law.history;
+        need.rolling = law.rolling;
+        impl_ = with_law_model(need, [&]<class M>() -> std::unique_ptr<MpiVariant> {
             return std::make_unique<RankProcessor<M>>(comm_, plan);
         });
         impl_->init(setup);
     }
+    bool supports(const ContactModel&) const override { return true; }  // every law of physics.md §9
     void predict(std::int64_t step) override { impl_->predict(step); }
     void search() override { impl_->search(); }
     void forces() override { impl_->forces(); }

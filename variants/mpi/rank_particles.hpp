@@ -46,8 +46,11 @@ struct RankParticles {
     // Appends the migrants in `in` as owned particles (ghosts must have been dropped).
     void add_migrants(const std::vector<double>& in)
     {
-        for (std::size_t k = 0; k + kMigrantDoubles <= in.size(); k += kMigrantDoubles) {
-            const double* p = &in[k];
+        for (std::size_t k = 0; k + kMigrantDoubles <= in.size(); k += kMigrantDoubles) add_migrant(&in[k]);
+    }
+    void add_migrant(const double* p)
+    {
+        {
             const std::size_t l = n_owned;
             resize_owned(l + 1);
             id[l] = double_to_id(p[0]);

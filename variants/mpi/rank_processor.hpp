@@ -20,6 +20,7 @@
 // is sent back. So every owned particle receives exactly the terms arrays gives it, in arrays' order.
 #include <algorithm>
 #include <cstdint>
+#include <unordered_map>
 #include <vector>
 
 #include <fmt/format.h>
@@ -27,8 +28,10 @@
 #include "comm.hpp"
 #include "mpi_variant.hpp"
 #include "rank_particles.hpp"
+#include "rank_stretches.hpp"
 #include "slabs.hpp"
 #include "demmat/contact_law.hpp"
+#include "demmat/contact_memory.hpp"
 #include "demmat/error.hpp"
 #include "demmat/integrators.hpp"
 #include "demmat/linked_cells.hpp"
@@ -58,6 +61,7 @@ public:
         dt_ = setup.scene->dt;
         coef_ = GearCoefficients<double>::make(dt_);
         params_ = setup.contact;
+        memory_ = setup.memory;
         g_ = setup.scene->gravity;
         walls_ = s.walls;
         wp_.resize(walls_.size());
@@ -85,6 +89,7 @@ public:
         p_ = RankParticles{};
         p_.add_migrants(comm_.scatter(parts));
         for (std::size_t l = 0; l < p_.owned(); ++l) p_.f[l] = p_.t[l] = Vec3d{};
+        if constexpr (M::memory) load_stretches(s);
         owned_max_ = std::int64_t(p_.owned());
         steps_ = 0;
         migrants_ = 0;
@@ -111,6 +116,14 @@ public:
             migrate();
             exchange_ghosts();
             find_pairs();
+            if constexpr (M::memory) {  // each new pair takes its stretch by key; the others start at zero
+                st_.pair.assign(pairs_.size(), Stretch<double>{});
+                for (std::size_t k = 0; k < pairs_.size(); ++k) {
+                    const auto it = st_.pending.find({p_.id[std::size_t(pairs_[k].i)], p_.id[std::size_t(pairs_[k].j)]});
+                    if (it != st_.pending.end()) st_.pair[k] = it->second;
+                }
+                st_.pending.clear();
+            }
             x_built_.assign(p_.x.begin(), p_.x.begin() + std::ptrdiff_t(p_.owned()));
             built_ = true;
             ++rebuilds_;
@@ -133,8 +146,16 @@ public:
         const std::size_t no = p_.owned();
         for (std::size_t k = 0; k < np; ++k) {
             const auto [i, j] = pairs_[k];
-            live_[k] = particle_contact<M>(p_.x[i], p_.x[j], p_.v[i], p_.v[j], p_.w[i], p_.w[j], p_.r[i], p_.r[j], p_.m[i], p_.m[j],
-                                           params_, mono_pp_, pf_[k]);
+            if constexpr (law) {  // a §9 law: the pair's stretch in and out (none to carry for restitution damping alone)
+                Stretch<double> s{};
+                if constexpr (M::memory) s = st_.pair[k];
+                live_[k] = particle_contact_memory<M>(p_.x[i], p_.x[j], p_.v[i], p_.v[j], p_.w[i], p_.w[j], p_.r[i], p_.r[j], p_.m[i],
+                                                      p_.m[j], params_, memory_, s, true, pf_[k]);
+                if constexpr (M::memory) st_.pair[k] = live_[k] ? s : Stretch<double>{};
+            } else {
+                live_[k] = particle_contact<M>(p_.x[i], p_.x[j], p_.v[i], p_.v[j], p_.w[i], p_.w[j], p_.r[i], p_.r[j], p_.m[i], p_.m[j],
+                                               params_, mono_pp_, pf_[k]);
+            }
             if (std::size_t(i) < no) {  // counted where the lower id is owned: once over all ranks
                 ++candidates_;
                 if (live_[k]) ++pp_;
@@ -154,17 +175,33 @@ public:
                     if constexpr (M::rotation) t = t + c.t_j;
                 }
             }
-            if constexpr (M::walls)
-                for (std::size_t e = wall_start_[l]; e < wall_start_[l + 1]; ++e) {
-                    const Wall& wl = walls_[std::size_t(wall_rows_[e])];
+            if constexpr (M::walls) {
+                std::size_t e = wall_start_[l];
+                for (std::size_t w = 0; w < walls_.size(); ++w) {  // in wall order; the candidates are a sorted subset
+                    const bool candidate = e < wall_start_[l + 1] && std::size_t(wall_rows_[e]) == w;
+                    if (candidate) ++e;
+                    Stretch<double> none{};
+                    Stretch<double>& s = M::memory ? st_.wall_row(l)[w] : none;
+                    bool live = false;
                     ContactForce<double> c;
-                    if (!wall_contact<M>(p_.x[l], p_.v[l], p_.w[l], p_.r[l], p_.m[l], wp_[std::size_t(wall_rows_[e])], wl.normal,
-                                         wl.velocity, params_, mono_pw_, c))
-                        continue;
+                    if (candidate) {
+                        if constexpr (law)
+                            live = wall_contact_memory<M>(p_.x[l], p_.v[l], p_.w[l], p_.r[l], p_.m[l], wp_[w], walls_[w].normal,
+                                                          walls_[w].velocity, params_, memory_, s, true, c);
+                        else
+                            live = wall_contact<M>(p_.x[l], p_.v[l], p_.w[l], p_.r[l], p_.m[l], wp_[w], walls_[w].normal,
+                                                   walls_[w].velocity, params_, mono_pw_, c);
+                    }
+                    if constexpr (M::memory) {
+                        if (!live) s = Stretch<double>{};  // a contact no longer touching is forgotten
+                        st_.wall_live[l * walls_.size() + w] = live;
+                    }
+                    if (!live) continue;
                     ++pw_;
                     f = f + c.f_i;
                     if constexpr (M::rotation) t = t + c.t_i;
                 }
+            }
             p_.f[l] = f;
             p_.t[l] = t;
             p_.acc[l] = {acceleration(f.x, p_.m[l], g_.x), acceleration(f.y, p_.m[l], g_.y), acceleration(f.z, p_.m[l], g_.z)};
@@ -228,12 +265,14 @@ public:
                 q += 3;
             }
         }
+        if constexpr (M::memory) save_stretches(out);
     }
 
+    bool supports(const ContactModel&) const override { return true; }
     ContactCounts counts() const override { return {comm_.sum(pp_), comm_.sum(pw_), comm_.sum(candidates_)}; }
     std::size_t memory_bytes() const override
     {
-        return p_.memory_bytes() + pairs_.capacity() * sizeof(Pair) + rows_.capacity() * sizeof(Entry) +
+        return p_.memory_bytes() + st_.memory_bytes() + pairs_.capacity() * sizeof(Pair) + rows_.capacity() * sizeof(Entry) +
                (row_start_.capacity() + wall_start_.capacity()) * sizeof(std::size_t) + wall_rows_.capacity() * sizeof(std::int32_t) +
                pf_.capacity() * sizeof(ContactForce<double>) + live_.capacity() + cells_.memory_bytes();
     }
@@ -278,10 +317,33 @@ private:
     // Owned particles whose predicted position left the slab go to the neighbour that now owns it.
     void migrate()
     {
-        p_.drop_ghosts();
         down_.clear();
         up_.clear();
         const int me = comm_.rank();
+        const std::size_t record = kMigrantDoubles + (M::memory ? walls_.size() * RankStretches::kWallDoubles : 0);
+        down_.push_back(0.0);  // the count of migrants, then their records, then (a §9 law) their pairs' stretches
+        up_.push_back(0.0);
+        std::vector<double>& down_stretches = from_down_;  // scratch until the exchange
+        std::vector<double>& up_stretches = from_up_;
+        down_stretches.clear();
+        up_stretches.clear();
+        if constexpr (M::memory) {
+            // Every live pair's stretch by its key, while the ghosts' ids are still here; a migrant's pairs
+            // go with it (the rank it joins may not hold the partner).
+            for (std::size_t k = 0; k < pairs_.size() && k < live_.size(); ++k)
+                if (live_[k]) st_.pending[{p_.id[std::size_t(pairs_[k].i)], p_.id[std::size_t(pairs_[k].j)]}] = st_.pair[k];
+            for (std::size_t l = 0; l < p_.owned(); ++l) {
+                const int to = plan_.slabs.owner(axis_coordinate(l));
+                if (to == me || row_start_.size() <= l + 1) continue;
+                for (std::size_t e = row_start_[l]; e < row_start_[l + 1]; ++e) {
+                    const std::size_t k = std::size_t(rows_[e].pair);
+                    if (k < live_.size() && live_[k])
+                        pack_stretch(to < me ? down_stretches : up_stretches, p_.id[std::size_t(pairs_[k].i)],
+                                     p_.id[std::size_t(pairs_[k].j)], st_.pair[k]);
+                }
+            }
+        }
+        p_.drop_ghosts();
         for (std::size_t l = 0; l < p_.owned();) {
             const int to = plan_.slabs.owner(axis_coordinate(l));
             if (to == me) {
@@ -291,13 +353,92 @@ private:
             if (to != me - 1 && to != me + 1)
                 throw InstabilityError(fmt::format("particle {} moved across more than one slab in a step (from rank {} to {}): the run "
                                                    "has blown up", p_.id[l], me, to), -1, p_.id[l]);
-            p_.pack_migrant(l, to < me ? down_ : up_);
+            std::vector<double>& out = to < me ? down_ : up_;
+            p_.pack_migrant(l, out);
+            out[0] += 1.0;
+            if constexpr (M::memory) {
+                st_.pack_wall_row(l, out);
+                st_.move_owned(p_.owned() - 1, l);
+            }
             p_.remove_owned(l);
+            if constexpr (M::memory) st_.resize_owned(p_.owned());
             ++migrants_;
         }
+        down_.insert(down_.end(), down_stretches.begin(), down_stretches.end());
+        up_.insert(up_.end(), up_stretches.begin(), up_stretches.end());
         comm_.exchange(down_, up_, from_down_, from_up_, 1);
-        p_.add_migrants(from_down_);
-        p_.add_migrants(from_up_);
+        for (const std::vector<double>* in : {&from_down_, &from_up_}) {
+            if (in->empty()) continue;
+            const std::size_t n = std::size_t((*in)[0]);
+            for (std::size_t k = 0; k < n; ++k) {
+                const double* q = &(*in)[1 + k * record];
+                p_.add_migrant(q);
+                if constexpr (M::memory) {
+                    st_.resize_owned(p_.owned());
+                    st_.set_wall_row(p_.owned() - 1, q + kMigrantDoubles);
+                }
+            }
+            if constexpr (M::memory)
+                for (std::size_t at = 1 + n * record; at + kStretchDoubles <= in->size(); at += kStretchDoubles) {
+                    const double* q = &(*in)[at];
+                    st_.pending[{double_to_id(q[0]), double_to_id(q[1])}] = unpack_stretch(q);
+                }
+        }
+    }
+
+    // Rank 0's state's stretches, to the ranks that own a contact's particles (both, for a pair that
+    // straddles a face); the pairs wait in `pending` for the first rebuild.
+    void load_stretches(const State& s)
+    {
+        st_.walls = walls_.size();
+        st_.resize_owned(p_.owned());
+        std::vector<std::vector<double>> parts;
+        if (comm_.root()) {
+            parts.resize(std::size_t(comm_.size()));
+            auto owner = [&](std::int64_t i) { return plan_.slabs.owner(component(s.trans.x[std::size_t(i)], plan_.slabs.axis)); };
+            for (const ContactStretch& c : s.stretches) {
+                const Stretch<double> v{c.tangential, c.rolling};
+                const int oi = owner(c.i);
+                pack_stretch(parts[std::size_t(oi)], c.i, c.wall ? -1 - c.partner : c.partner, v);
+                if (!c.wall && owner(c.partner) != oi) pack_stretch(parts[std::size_t(owner(c.partner))], c.i, c.partner, v);
+            }
+        }
+        const std::vector<double> mine = comm_.scatter(parts);
+        std::unordered_map<std::int64_t, std::size_t> local;
+        for (std::size_t l = 0; l < p_.owned(); ++l) local[p_.id[l]] = l;
+        for (std::size_t at = 0; at + kStretchDoubles <= mine.size(); at += kStretchDoubles) {
+            const double* q = &mine[at];
+            const std::int64_t i = double_to_id(q[0]), j = double_to_id(q[1]);
+            if (j < 0) {
+                const std::size_t w = std::size_t(-1 - j), l = local.at(i);
+                st_.wall_row(l)[w] = unpack_stretch(q);
+                st_.wall_live[l * walls_.size() + w] = 1;
+            } else {
+                st_.pending[{i, j}] = unpack_stretch(q);
+            }
+        }
+    }
+
+    // Every live contact's stretch once (a pair where its lower id is owned, a wall contact of an owned
+    // particle), gathered on rank 0 in the canonical order.
+    void save_stretches(State& out) const
+    {
+        std::vector<double> mine;
+        const std::size_t no = p_.owned();
+        for (std::size_t k = 0; k < pairs_.size() && k < live_.size(); ++k)
+            if (live_[k] && std::size_t(pairs_[k].i) < no)
+                pack_stretch(mine, p_.id[std::size_t(pairs_[k].i)], p_.id[std::size_t(pairs_[k].j)], st_.pair[k]);
+        for (std::size_t l = 0; l < no; ++l)
+            for (std::size_t w = 0; w < walls_.size(); ++w)
+                if (st_.wall_live[l * walls_.size() + w]) pack_stretch(mine, p_.id[l], -1 - std::int64_t(w), st_.wall[l * walls_.size() + w]);
+        const std::vector<double> all = comm_.gather(mine);
+        for (std::size_t at = 0; at + kStretchDoubles <= all.size(); at += kStretchDoubles) {
+            const double* q = &all[at];
+            const std::int64_t i = double_to_id(q[0]), j = double_to_id(q[1]);
+            const Stretch<double> v = unpack_stretch(q);
+            out.stretches.push_back({i, j < 0 ? -1 - j : j, j < 0, v.t, v.r});
+        }
+        std::sort(out.stretches.begin(), out.stretches.end());
     }
 
     // Copies of the owned particles within the halo of a shared face, for the neighbour across it.
@@ -423,8 +564,12 @@ private:
         }
     }
 
+    static constexpr bool law = M::restitution_damping || M::history || M::rolling;  // a §9 law, not the paper's
+
     Comm comm_;
     Plan plan_;
+    MemoryParams<double> memory_;
+    RankStretches st_;  // a §9 law with memory: the stretches
     std::int64_t step_ = 0, steps_ = 0, owned_max_ = 0, migrants_ = 0, rebuilds_ = 0;
     bool built_ = false;
     std::vector<Vec3d> x_built_;                         // owned positions at the last rebuild
