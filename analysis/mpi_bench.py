@@ -8,6 +8,8 @@ Writes, in --out:
   bench_mpi.md     the comparison and the issue's targets, each said to be met or not
   halo_mpi.csv     one row per (N, R): particles, ghosts, messages and bytes per step per rank (mean, max)
   halo_mpi.md      the same as a table
+  imbalance_mpi.csv, .md  particles per rank (max/mean at the end, the most a rank held/mean) of the static
+                   slabs on the bed and the compression stage, cut by count and evenly, at R = 2 and 4
 Usage: mpi_bench.py --work DIR --versions FILE --out DIR
 """
 import argparse
@@ -71,6 +73,21 @@ def halo(work):
     return pd.DataFrame(rows).sort_values(["N", "R"]) if rows else pd.DataFrame()
 
 
+def imbalance(work):
+    rows = []
+    for path in sorted(glob.glob(os.path.join(work, "imbalance_n*_*_*_np*.json"))):
+        n, stage, balance, np_ = re.search(r"imbalance_n(\d+)_(\w+?)_(count|even)_np(\d+)\.json$", path).groups()
+        r = results.load(path)
+        t = r.table[r.table["phase"] == "predict"]
+        ranks = r.meta["decomposition"]["ranks"]
+        most = max(q["particles_most"] for q in ranks)
+        mean = t["particles"].mean()
+        rows.append({"N": int(n), "stage": stage, "balance": balance, "R": int(np_), "steps": r.meta["steps"],
+                     "max_over_mean": t["particles"].max() / mean, "most_held_over_mean": most / mean,
+                     "min_over_mean": t["particles"].min() / mean})
+    return pd.DataFrame(rows).sort_values(["N", "stage", "balance", "R"]) if rows else pd.DataFrame()
+
+
 def verdict(ok):
     return "met" if ok else "not met"
 
@@ -132,6 +149,19 @@ def main():
             lines.append(f"| {r.N} | {r.R} | {r.particles_mean:.0f}, {r.particles_max:.0f} | {r.ghosts_mean:.0f}, {r.ghosts_max:.0f} | "
                          f"{r.messages_per_step_mean:.2f}, {r.messages_per_step_max:.0f} | {r.bytes_per_step_mean:.0f}, {r.bytes_per_step_max:.0f} |")
         write_text(os.path.join(a.out, "halo_mpi.md"), "\n".join(lines) + "\n")
+
+    im = imbalance(a.work)
+    if not im.empty:
+        im.to_csv(os.path.join(a.out, "imbalance_mpi.csv.tmp"), index=False)
+        os.replace(os.path.join(a.out, "imbalance_mpi.csv.tmp"), os.path.join(a.out, "imbalance_mpi.csv"))
+        lines = ["# Imbalance of the static slabs (scripts/run_mpi_bench.sh)", "",
+                 f"Suite: {results.provenance_line(prov)}. Particles per rank over their mean after the run (max, min), and "
+                 "the most any rank held during it over the mean; slabs cut at init by count (quantiles) or evenly.", "",
+                 "| N | stage | cut | R | steps | max/mean | min/mean | most held/mean |", "|---|---|---|---|---|---|---|---|"]
+        for _, r in im.iterrows():
+            lines.append(f"| {r.N} | {r.stage} | {r.balance} | {r.R} | {r.steps} | {r.max_over_mean:.3f} | {r.min_over_mean:.3f} | "
+                         f"{r.most_held_over_mean:.3f} |")
+        write_text(os.path.join(a.out, "imbalance_mpi.md"), "\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":

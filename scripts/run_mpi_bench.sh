@@ -6,17 +6,19 @@
 #   LAMMPS on 2 processes (mpirun -np 2 lmp) on the same particles and law (demmat export-lammps),
 # each a median of µs per particle-step; then the halo traffic (messages and bytes per step per rank,
 # ghosts per rank) of mpi at R = 2 and 4 for every N of --halo-n, measured on the dense bed's lattice
-# (a few steps from t = 0: the counts, not the times, are what is kept); then the scaling model of
+# (a few steps from t = 0: the counts, not the times, are what is kept); the imbalance of the static
+# slabs on the bed and the compression stage (cut by count and evenly); then the scaling model of
 # docs/scaling.md from these measurements (analysis/mpi_scaling.py). Results in results/mpi/.
 # Usage: scripts/run_mpi_bench.sh [--n "100000"] [--halo-n "10000 100000 1000000"] [--steps K] [--repetitions R]
-#                                 [--settle-time T] [--out DIR] [--build-dir DIR]
+#                                 [--settle-time T] [--imbalance-steps K] [--out DIR] [--build-dir DIR]
 #   default          N = 10^5; 200 steps, 5 repetitions; halo at N = 10^4, 10^5, 10^6; beds settled 0.4 s
 #   --n LIST         the sizes of the timed comparison;  --halo-n LIST: the sizes of the halo measurement
 #   --settle-time T  simulated seconds of settling before the timed runs (0.4; a tiny test passes less)
+#   --imbalance-steps K  steps of the imbalance runs (5000: the compression wall moves 2.5 cm)
 #   --out DIR        results in DIR instead of results/mpi
 #   --build-dir DIR  the build folder (default build, or $DEMMAT_BUILD_DIR); work files in DIR/mpi_bench
 source "$(dirname "$0")/lib.sh"
-ns="100000"; halo_ns="10000 100000 1000000"; steps=200; reps=5; settle=0.4; warmup=20; out=results/mpi
+ns="100000"; halo_ns="10000 100000 1000000"; steps=200; reps=5; settle=0.4; warmup=20; out=results/mpi; imb_steps=5000
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --n) need_value "$@"; ns=$2; shift 2 ;;
@@ -24,12 +26,13 @@ while [[ $# -gt 0 ]]; do
     --steps) need_value "$@"; steps=$2; shift 2 ;;
     --repetitions) need_value "$@"; reps=$2; shift 2 ;;
     --settle-time) need_value "$@"; settle=$2; shift 2 ;;
+    --imbalance-steps) need_value "$@"; imb_steps=$2; shift 2 ;;
     --out) need_value "$@"; out=$2; shift 2 ;;
     *) shared_option "$@"; shift "$SHIFT" ;;
   esac
 done
 for n in $ns $halo_ns; do positive_int --n "$n"; done
-positive_int --steps "$steps"; positive_int --repetitions "$reps"
+positive_int --steps "$steps"; positive_int --repetitions "$reps"; positive_int --imbalance-steps "$imb_steps"
 [[ $settle =~ ^[0-9]*\.?[0-9]+([eE]-?[0-9]+)?$ ]] || { echo "$SCRIPT: --settle-time must be a number of seconds, not '$settle'" >&2; exit 2; }
 (( steps > warmup )) || warmup=1
 
@@ -62,7 +65,7 @@ prepare() {
   if [[ ! -f $d/settled_$settle.state ]]; then
     echo "== settling the dense bed of $n particles ($settle s simulated, once; kept in $d)"
     $demmat run "$d/loose.toml" --variant fast --threads "$JOBS" --time "$settle" --save "$d/settled_$settle.state" --quiet >/dev/null
-    rm -f "$d/bed.toml" "$d/bed.data" "$d/bed.lammps"
+    rm -f "$d/bed.toml" "$d/bed.data" "$d/bed.lammps" "$d/compression.toml"
   fi
   # The settled bed: the loose scene with its particles from the state (the [particles] table is the last).
   [[ -f $d/bed.toml ]] || { sed '/^\[particles\]/,$d' "$d/loose.toml"; printf '[particles]\nsource = "state"\nfile = "settled_%s.state"\n' "$settle"; } \
@@ -101,6 +104,22 @@ for n in $halo_ns; do
   $demmat scene dense-bed --n "$n" -o "$work/halo_n$n.toml"
   for np in 2 4; do
     "${mpirun_shared[@]}" -np "$np" "$demmat_mpi" run "$work/halo_n$n.toml" --steps 5 --json "$work/halo_n${n}_np$np.json" -q >/dev/null
+  done
+done
+
+# Imbalance of the static slabs: the settled bed and the compression stage (the x_max wall moving in at
+# 0.5 m/s, the slabs along x: the slab by the wall empties), cut by count and evenly, at R = 2 and 4;
+# the counts per rank, not the times, are what is kept (R = 4 shares the cores).
+for n in $ns; do
+  d=$work/n$n
+  [[ -f $d/compression.toml ]] || $demmat scene compression --from "$d/loose.toml" --state "$d/settled_$settle.state" -o "$d/compression.toml"
+  for stage in bed compression; do
+    for balance in count even; do
+      for np in 2 4; do
+        "${mpirun_shared[@]}" -np "$np" "$demmat_mpi" run "$d/$stage.toml" --steps "$imb_steps" --balance "$balance" \
+          --json "$work/imbalance_n${n}_${stage}_${balance}_np$np.json" -q >/dev/null
+      done
+    done
   done
 done
 

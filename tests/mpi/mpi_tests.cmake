@@ -45,3 +45,12 @@ if(TARGET demmat_mpi)
                                   ${PROJECT_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/mpi_cli_work ${DEMMAT_MPIRUN})
   set_tests_properties(mpi.cli PROPERTIES TIMEOUT 300 PROCESSORS 3 ENVIRONMENT "${DEMMAT_MPI_TEST_ENV}")
 endif()
+
+# The benchmark's pipeline at a tiny size (scripts/run_mpi_bench.sh; results in the build folder): it
+# settles, runs every configuration, LAMMPS where installed, and the analysis. Long: a minute of runs.
+if(TARGET demmat_mpi)
+  add_test(NAME scripts.mpi_bench_tiny
+           COMMAND bash ${PROJECT_SOURCE_DIR}/scripts/run_mpi_bench.sh --build-dir ${CMAKE_BINARY_DIR} --n 800 --halo-n 800 --steps 10
+                   --repetitions 1 --settle-time 0.002 --imbalance-steps 10 --out ${CMAKE_CURRENT_BINARY_DIR}/mpi_bench_tiny)
+  set_tests_properties(scripts.mpi_bench_tiny PROPERTIES TIMEOUT 600 LABELS long PASS_REGULAR_EXPRESSION "results in")
+endif()
