@@ -110,6 +110,8 @@ int cmd_run(const Comm& comm, const Args& a)
     const double n = double(p->size());
     std::cout << fmt::format("variant mpi  scene {}  particles {}  steps {}  t = {:.6g} s  processes {}\n", p->scene().name,
                              p->size(), steps, driver.time(), comm.size());
+    if (!p->scene().contact_model.is_paper())
+        std::cout << "contact law " << describe_law(p->scene().contact_model, p->setup().memory) << "\n";
     std::cout << fmt::format("model {}  (the scene needs {})\n", v->model().name(), features_of(p->scene(), p->state()).name());
     print_report(std::cout, r, n);
     std::cout << fmt::format("contacts per particle {:.3f} (particle-particle {}, particle-wall {})  kinetic energy {:.6e} J\n",
