@@ -25,6 +25,7 @@
 #include "demmat/registry.hpp"
 #include "demmat/stability.hpp"
 #include "cli_ranges.hpp"
+#include "leak_check.hpp"
 #include "lockstep.hpp"
 #include "mpi_report.hpp"
 #include "mpi_variant.hpp"
@@ -216,6 +217,7 @@ int main(int argc, char** argv)
     MPI_Init(&argc, &argv);
     const Comm comm(MPI_COMM_WORLD);
     auto finish = [](int rc) {
+        check_leaks_before_finalize();
         MPI_Finalize();
         return rc;
     };

@@ -11,6 +11,7 @@
 #include <gtest/gtest.h>
 #include <mpi.h>
 
+#include "leak_check.hpp"
 #include "lockstep.hpp"
 #include "mpi_variant.hpp"
 #include "support.hpp"
@@ -246,6 +247,7 @@ int main(int argc, char** argv)
     int failed = RUN_ALL_TESTS() != 0;
     int any = 0;
     MPI_Allreduce(&failed, &any, 1, MPI_INT, MPI_MAX, MPI_COMM_WORLD);
+    check_leaks_before_finalize();
     MPI_Finalize();
     return any;
 }
