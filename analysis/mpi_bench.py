@@ -147,7 +147,7 @@ def main():
                  "|---|---|---|---|---|---|"]
         for _, r in h.iterrows():
             lines.append(f"| {r.N} | {r.R} | {r.particles_mean:.0f}, {r.particles_max:.0f} | {r.ghosts_mean:.0f}, {r.ghosts_max:.0f} | "
-                         f"{r.messages_per_step_mean:.2f}, {r.messages_per_step_max:.0f} | {r.bytes_per_step_mean:.0f}, {r.bytes_per_step_max:.0f} |")
+                         f"{r.messages_per_step_mean:.2f}, {r.messages_per_step_max:.2f} | {r.bytes_per_step_mean:.0f}, {r.bytes_per_step_max:.0f} |")
         write_text(os.path.join(a.out, "halo_mpi.md"), "\n".join(lines) + "\n")
 
     im = imbalance(a.work)
