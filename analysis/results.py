@@ -2,6 +2,8 @@
 
 One loader for every schema, so that no script parses a result file of its own:
   demmat bench --json   (app/main.cpp cmd_bench)        kind "bench"
+  demmat_mpi bench/run --json (app/mpi_main.cpp)        kind "mpi": one row per (rank, phase), with the
+                        rank's particles, ghosts, messages and bytes per step
   demmat run --json     (app/main.cpp cmd_run)          kind "run"
   Google Benchmark JSON (bench/bench_suite.cpp, bench/bench_features.cpp): the label of each benchmark is
                         a JSON object, its counters the measurements; provenance as a "provenance"
@@ -81,6 +83,8 @@ def load(path):
         raw = json.load(f)
     if "benchmarks" in raw and "context" in raw:
         return _gbench(path, raw)
+    if raw.get("variant") == "mpi" and "processes" in raw:
+        return _mpi(path, raw)
     if "samples" in raw and "scene" in raw:
         return _bench(path, raw)
     if "wall_seconds" in raw and "scene" in raw:
@@ -134,6 +138,23 @@ def _bench(path, raw):
     meta = {k: v for k, v in raw.items() if k not in ("samples", "provenance")}
     return Result("bench", path, normalise_provenance(raw["provenance"]),
                   df[["variant", "threads", "threads_asked", "N", "phase", "repetition", "seconds", "sample"]], meta)
+
+
+MPI_PHASES = ["predict", "communicate", "search", "forces", "correct"]
+
+
+def _mpi(path, raw):
+    # bench: the median repetition's decomposition; run: the run's.
+    dec = raw["median"] if "median" in raw else raw["decomposition"]
+    rows = []
+    for q in dec["ranks"]:
+        for p in MPI_PHASES:
+            rows.append({"variant": "mpi", "processes": raw["processes"], "threads": 1, "N": raw["scene"]["particles"],
+                         "rank": q["rank"], "phase": p, "repetition": 0, "seconds": q["seconds_per_step"][p], "sample": 0,
+                         "particles": q["particles"], "ghosts": q["ghosts"], "messages_per_step": q["messages_per_step"],
+                         "bytes_per_step": q["bytes_per_step"], "migrants_per_step": q["migrants_per_step"]})
+    meta = {k: v for k, v in raw.items() if k not in ("provenance", "samples")}
+    return Result("mpi", path, normalise_provenance(raw["provenance"]), pd.DataFrame(rows), meta)
 
 
 def _run(path, raw):

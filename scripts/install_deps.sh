@@ -13,6 +13,7 @@ required=(
   gfortran fp-compiler
   python3 python3-pandas python3-matplotlib
   time
+  libopenmpi-dev openmpi-bin
 )
 optional=(lammps liggghts valgrind)
 fuzz=(clang-14 libclang-rt-14-dev)

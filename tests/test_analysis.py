@@ -3,7 +3,8 @@
 
 The samples in tests/data/analysis/ are trimmed copies of real results: bench_sample.json of
 `demmat bench --json` (arrays and fast, two repetitions), gbench_sample.json of demmat_bench's Google
-Benchmark JSON (fast on the settled bed of 8000 at 1 and 2 threads, two STREAM kernels).
+Benchmark JSON (fast on the settled bed of 8000 at 1 and 2 threads, two STREAM kernels),
+mpi_bench_sample.json of `mpirun -np 2 demmat_mpi bench --json` (the loose bed of 2000, two repetitions).
 Run by ctest (analysis.results) with /usr/bin/python3.
 """
 import os
@@ -41,6 +42,17 @@ class Loader(unittest.TestCase):
         self.assertEqual(len(w), 4)  # one row per sample
         a0 = w[(w.variant == "arrays") & (w.repetition == 0)].iloc[0]
         self.assertAlmostEqual(a0.total_s, a0.predict_s + a0.search_s + a0.forces_s + a0.correct_s, delta=0)
+
+    def test_demmat_mpi_bench(self):
+        r = results.load(os.path.join(DATA, "mpi_bench_sample.json"))
+        self.assertEqual(r.kind, "mpi")
+        self.assertEqual(r.meta["processes"], 2)
+        self.assertEqual(len(r.table), 2 * len(results.MPI_PHASES))  # one row per (rank, phase) of the median repetition
+        self.assertEqual(sorted(set(r.table["rank"])), [0, 1])
+        per_rank = r.table[r.table.phase == "predict"]
+        self.assertEqual(per_rank.particles.sum(), 2000)  # every particle owned once
+        self.assertTrue((per_rank.ghosts > 0).all())
+        self.assertTrue((per_rank.messages_per_step >= 1).all())  # one refresh to the neighbour per step, at least
 
     def test_two_configurations_on_the_same_threads_stay_two_samples(self):
         # fast asked for 1 and 2 threads on a small bed runs on 1 both times: still two samples each

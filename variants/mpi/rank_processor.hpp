@@ -1,0 +1,599 @@
+#pragma once
+// The phases on one rank (docs/variants.md, "mpi"), for model M (model.hpp), gear5 in double:
+//
+//   predict  the Gear predictor on the owned particles; moving walls placed from the step number (every
+//            rank computes the same wall positions, nothing is sent for them)
+//   search   a neighbour list with a skin, as fast keeps one: rebuilt when some particle on some rank
+//            has moved more than 0.45 skin since the last rebuild (one allreduce of a flag per step).
+//            At a rebuild, communicate: owned particles that left the slab migrate to the neighbour (with
+//            their whole Gear history), then each rank sends its neighbours ghost copies of its particles
+//            within the interaction range plus the skin of the shared face, and remembers whom it sent;
+//            the cell search over owned and ghosts lists every pair with an owned particle closer than
+//            R_i + R_j + skin. Between rebuilds, communicate only refreshes the ghosts (position,
+//            velocity, angular velocity of the same particles, in the same order). A particle moves
+//            less than half the skin between rebuilds, so the list holds every contact (the law decides)
+//   forces   each pair's force once per rank, by the shared law with the lower id as i; each owned
+//            particle's sum in the canonical order (partners ascending by id, then walls in order)
+//   correct  the Gear corrector on the owned particles
+//
+// A pair that straddles a face is computed by both ranks from the same inputs (the same bits); no force
+// is sent back. So every owned particle receives exactly the terms arrays gives it, in arrays' order.
+#include <algorithm>
+#include <cstdint>
+#include <unordered_map>
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "comm.hpp"
+#include "mpi_variant.hpp"
+#include "rank_particles.hpp"
+#include "rank_stretches.hpp"
+#include "slabs.hpp"
+#include "demmat/contact_law.hpp"
+#include "demmat/contact_memory.hpp"
+#include "demmat/error.hpp"
+#include "demmat/integrators.hpp"
+#include "demmat/linked_cells.hpp"
+
+namespace demmat::mpi {
+
+// What rank 0 decides at init and every rank receives: the model, the slabs, the lengths.
+struct Plan {
+    ModelFeatures features;
+    Slabs slabs;
+    double radius_max = 0.0;
+    double cell = 0.0;   // edge of the search's cells
+    double skin = 0.0;   // the neighbour list's skin
+    double halo = 0.0;   // ghosts: particles within this distance of a shared face (contact range + skin)
+    double r0 = 0.0, m0 = 0.0;  // particle 0's radius and mass (a monodisperse model's coefficients)
+};
+
+template <class M>
+class RankProcessor final : public MpiVariant {
+public:
+    RankProcessor(const Comm& comm, const Plan& plan) : comm_(comm), plan_(plan) {}
+
+    void init(const Setup& setup) override
+    {
+        const State& s = *setup.state;
+        step_ = s.step;
+        dt_ = setup.scene->dt;
+        coef_ = GearCoefficients<double>::make(dt_);
+        params_ = setup.contact;
+        memory_ = setup.memory;
+        g_ = setup.scene->gravity;
+        walls_ = s.walls;
+        wp_.resize(walls_.size());
+        place_walls(step_);
+        if constexpr (!M::polydisperse) {
+            mono_pp_ = pair_coefficients(plan_.r0, plan_.r0, plan_.m0, plan_.m0, params_);
+            mono_pw_ = wall_coefficients(plan_.r0, plan_.m0, params_);
+        }
+        // Rank 0 holds the whole state: each rank receives its slab's particles as migrants.
+        std::vector<std::vector<double>> parts;
+        if (comm_.root()) {
+            parts.resize(std::size_t(comm_.size()));
+            const std::vector<Vec3d>* g[12] = {&s.trans.x, &s.trans.v, &s.trans.a, &s.trans.b3, &s.trans.b4, &s.trans.b5,
+                                               &s.rot.x,   &s.rot.v,   &s.rot.a,   &s.rot.b3,   &s.rot.b4,   &s.rot.b5};
+            for (std::size_t i = 0; i < s.size(); ++i) {
+                std::vector<double>& out = parts[std::size_t(plan_.slabs.owner(component(s.trans.x[i], plan_.slabs.axis)))];
+                out.push_back(id_to_double(std::int64_t(i)));
+                out.push_back(s.radius[i]);
+                out.push_back(setup.mass[i]);
+                out.push_back(setup.inertia[i]);
+                for (const auto* q : g)
+                    for (int c = 0; c < 3; ++c) out.push_back(component((*q)[i], c));
+            }
+        }
+        p_ = RankParticles{};
+        p_.add_migrants(comm_.scatter(parts));
+        for (std::size_t l = 0; l < p_.owned(); ++l) p_.f[l] = p_.t[l] = Vec3d{};
+        if constexpr (M::memory) load_stretches(s);
+        owned_max_ = std::int64_t(p_.owned());
+        steps_ = 0;
+        migrants_ = 0;
+        rebuilds_ = 0;
+        built_ = false;
+    }
+
+    void predict(std::int64_t step) override
+    {
+        step_ = step;
+        for (std::size_t l = 0; l < p_.owned(); ++l) {
+            each_component([&](auto c) {
+                Gear5Scheme::predict(c(p_.x[l]), c(p_.v[l]), c(p_.a[l]), c(p_.b3[l]), c(p_.b4[l]), c(p_.b5[l]), coef_);
+                if constexpr (M::rotation)
+                    Gear5Scheme::predict(c(p_.th[l]), c(p_.w[l]), c(p_.al[l]), c(p_.q3[l]), c(p_.q4[l]), c(p_.q5[l]), coef_);
+            });
+        }
+        if constexpr (M::moving_walls) place_walls(step);
+    }
+
+    void search() override
+    {
+        if (!built_ || must_rebuild()) {
+            migrate();
+            exchange_ghosts();
+            find_pairs();
+            if constexpr (M::memory) {  // each new pair takes its stretch by key; the others start at zero
+                st_.pair.assign(pairs_.size(), Stretch<double>{});
+                for (std::size_t k = 0; k < pairs_.size(); ++k) {
+                    const auto it = st_.pending.find({p_.id[std::size_t(pairs_[k].i)], p_.id[std::size_t(pairs_[k].j)]});
+                    if (it != st_.pending.end()) st_.pair[k] = it->second;
+                }
+                st_.pending.clear();
+            }
+            x_built_.assign(p_.x.begin(), p_.x.begin() + std::ptrdiff_t(p_.owned()));
+            built_ = true;
+            ++rebuilds_;
+        } else {
+            refresh_ghosts();
+        }
+        if constexpr (M::walls) find_walls();  // every step, without a skin: a wall may move
+        ++steps_;
+        owned_max_ = std::max(owned_max_, std::int64_t(p_.owned()));
+    }
+
+    void forces() override
+    {
+        const std::size_t np = pairs_.size();
+        pf_.resize(np);
+        live_.resize(np);
+        pp_ = 0;
+        pw_ = 0;
+        candidates_ = 0;
+        const std::size_t no = p_.owned();
+        for (std::size_t k = 0; k < np; ++k) {
+            const auto [i, j] = pairs_[k];
+            if constexpr (law) {  // a §9 law: the pair's stretch in and out (none to carry for restitution damping alone)
+                Stretch<double> s{};
+                if constexpr (M::memory) s = st_.pair[k];
+                live_[k] = particle_contact_memory<M>(p_.x[i], p_.x[j], p_.v[i], p_.v[j], p_.w[i], p_.w[j], p_.r[i], p_.r[j], p_.m[i],
+                                                      p_.m[j], params_, memory_, s, true, pf_[k]);
+                if constexpr (M::memory) st_.pair[k] = live_[k] ? s : Stretch<double>{};
+            } else {
+                live_[k] = particle_contact<M>(p_.x[i], p_.x[j], p_.v[i], p_.v[j], p_.w[i], p_.w[j], p_.r[i], p_.r[j], p_.m[i], p_.m[j],
+                                               params_, mono_pp_, pf_[k]);
+            }
+            if (std::size_t(i) < no) {  // counted where the lower id is owned: once over all ranks
+                ++candidates_;
+                if (live_[k]) ++pp_;
+            }
+        }
+        for (std::size_t l = 0; l < no; ++l) {
+            Vec3d f{}, t{};
+            for (std::size_t e = row_start_[l]; e < row_start_[l + 1]; ++e) {
+                const Entry& en = rows_[e];
+                if (!live_[std::size_t(en.pair)]) continue;  // a pair the law rejects adds nothing, not even a zero
+                const ContactForce<double>& c = pf_[std::size_t(en.pair)];
+                if (en.lower) {
+                    f = f + c.f_i;
+                    if constexpr (M::rotation) t = t + c.t_i;
+                } else {
+                    f = f + (-c.f_i);
+                    if constexpr (M::rotation) t = t + c.t_j;
+                }
+            }
+            if constexpr (M::walls) {
+                std::size_t e = wall_start_[l];
+                for (std::size_t w = 0; w < walls_.size(); ++w) {  // in wall order; the candidates are a sorted subset
+                    const bool candidate = e < wall_start_[l + 1] && std::size_t(wall_rows_[e]) == w;
+                    if (candidate) ++e;
+                    Stretch<double> none{};
+                    Stretch<double>& s = M::memory ? st_.wall_row(l)[w] : none;
+                    bool live = false;
+                    ContactForce<double> c;
+                    if (candidate) {
+                        if constexpr (law)
+                            live = wall_contact_memory<M>(p_.x[l], p_.v[l], p_.w[l], p_.r[l], p_.m[l], wp_[w], walls_[w].normal,
+                                                          walls_[w].velocity, params_, memory_, s, true, c);
+                        else
+                            live = wall_contact<M>(p_.x[l], p_.v[l], p_.w[l], p_.r[l], p_.m[l], wp_[w], walls_[w].normal,
+                                                   walls_[w].velocity, params_, mono_pw_, c);
+                    }
+                    if constexpr (M::memory) {
+                        if (!live) s = Stretch<double>{};  // a contact no longer touching is forgotten
+                        st_.wall_live[l * walls_.size() + w] = live;
+                    }
+                    if (!live) continue;
+                    ++pw_;
+                    f = f + c.f_i;
+                    if constexpr (M::rotation) t = t + c.t_i;
+                }
+            }
+            p_.f[l] = f;
+            p_.t[l] = t;
+            p_.acc[l] = {acceleration(f.x, p_.m[l], g_.x), acceleration(f.y, p_.m[l], g_.y), acceleration(f.z, p_.m[l], g_.z)};
+            if constexpr (M::rotation) p_.alc[l] = t / p_.inertia[l];
+        }
+    }
+
+    void correct() override
+    {
+        for (std::size_t l = 0; l < p_.owned(); ++l) {
+            each_component([&](auto c) {
+                Gear5Scheme::correct(c(p_.x[l]), c(p_.v[l]), c(p_.a[l]), c(p_.b3[l]), c(p_.b4[l]), c(p_.b5[l]), c(p_.acc[l]), coef_);
+                if constexpr (M::rotation)
+                    Gear5Scheme::correct(c(p_.th[l]), c(p_.w[l]), c(p_.al[l]), c(p_.q3[l]), c(p_.q4[l]), c(p_.q5[l]), c(p_.alc[l]), coef_);
+            });
+        }
+    }
+
+    void snapshot(Snapshot& out) const override
+    {
+        std::vector<double> mine;
+        mine.reserve(16 * p_.owned());
+        for (std::size_t l = 0; l < p_.owned(); ++l) {
+            mine.push_back(id_to_double(p_.id[l]));
+            for (const Vec3d* q : {&p_.x[l], &p_.v[l], &p_.w[l], &p_.f[l], &p_.t[l]})
+                for (int c = 0; c < 3; ++c) mine.push_back(component(*q, c));
+        }
+        const std::vector<double> all = comm_.gather(mine);
+        out.step = step_;
+        out.resize(all.size() / 16);
+        for (std::size_t k = 0; k + 16 <= all.size(); k += 16) {
+            const std::size_t i = std::size_t(double_to_id(all[k]));
+            const double* q = &all[k + 1];
+            Vec3d* dst[5] = {&out.position[i], &out.velocity[i], &out.angular_velocity[i], &out.force[i], &out.torque[i]};
+            for (Vec3d* d : dst) {
+                *d = {q[0], q[1], q[2]};
+                q += 3;
+            }
+        }
+    }
+
+    void save(State& out) const override
+    {
+        std::vector<double> mine;
+        mine.reserve(kMigrantDoubles * p_.owned());
+        for (std::size_t l = 0; l < p_.owned(); ++l) p_.pack_migrant(l, mine);
+        const std::vector<double> all = comm_.gather(mine);
+        out = State{};
+        out.step = step_;
+        out.walls = walls_;
+        out.resize(all.size() / kMigrantDoubles);
+        std::vector<Vec3d>* g[12] = {&out.trans.x, &out.trans.v, &out.trans.a, &out.trans.b3, &out.trans.b4, &out.trans.b5,
+                                     &out.rot.x,   &out.rot.v,   &out.rot.a,   &out.rot.b3,   &out.rot.b4,   &out.rot.b5};
+        for (std::size_t k = 0; k + kMigrantDoubles <= all.size(); k += kMigrantDoubles) {
+            const double* q = &all[k];
+            const std::size_t i = std::size_t(double_to_id(q[0]));
+            out.radius[i] = q[1];  // as given: a continued run derives the same masses
+            q += 4;
+            for (auto* d : g) {
+                (*d)[i] = {q[0], q[1], q[2]};
+                q += 3;
+            }
+        }
+        if constexpr (M::memory) save_stretches(out);
+    }
+
+    bool supports(const ContactModel&) const override { return true; }
+    ContactCounts counts() const override { return {comm_.sum(pp_), comm_.sum(pw_), comm_.sum(candidates_)}; }
+    std::size_t memory_bytes() const override
+    {
+        return p_.memory_bytes() + st_.memory_bytes() + pairs_.capacity() * sizeof(Pair) + rows_.capacity() * sizeof(Entry) +
+               (row_start_.capacity() + wall_start_.capacity()) * sizeof(std::size_t) + wall_rows_.capacity() * sizeof(std::int32_t) +
+               pf_.capacity() * sizeof(ContactForce<double>) + live_.capacity() + cells_.memory_bytes();
+    }
+    ModelFeatures model() const override { return ModelFeatures::of<M>(); }
+
+    const Comm& comm() const override { return comm_; }
+    double communicate_seconds() const override { return comm_.traffic().seconds; }
+    const Slabs& slabs() const override { return plan_.slabs; }
+    double halo() const override { return plan_.halo; }
+    RankReport local_report() const override
+    {
+        return {comm_.rank(), std::int64_t(p_.owned()), std::int64_t(p_.size() - p_.owned()), owned_max_, steps_, migrants_, rebuilds_,
+                comm_.traffic()};
+    }
+
+private:
+    struct Pair {
+        std::int32_t i, j;  // local indices, id[i] < id[j]
+    };
+    struct Entry {
+        std::int64_t partner;  // the partner's id: the key of the canonical order
+        std::int32_t pair;
+        bool lower;            // this particle is the pair's i (the lower id)
+    };
+
+    // f(c) for the three components, c(v) being v.x, v.y or v.z (no run-time branch per value).
+    template <class F>
+    static void each_component(F&& f)
+    {
+        f([](auto& v) -> auto& { return v.x; });
+        f([](auto& v) -> auto& { return v.y; });
+        f([](auto& v) -> auto& { return v.z; });
+    }
+
+    void place_walls(std::int64_t step)
+    {
+        for (std::size_t w = 0; w < walls_.size(); ++w) wp_[w] = walls_[w].point_at(step, dt_);
+    }
+
+    double axis_coordinate(std::size_t l) const { return component(p_.x[l], plan_.slabs.axis); }
+
+    // Owned particles whose predicted position left the slab go to the neighbour that now owns it.
+    void migrate()
+    {
+        down_.clear();
+        up_.clear();
+        const int me = comm_.rank();
+        const std::size_t record = kMigrantDoubles + (M::memory ? walls_.size() * RankStretches::kWallDoubles : 0);
+        down_.push_back(0.0);  // the count of migrants, then their records, then (a §9 law) their pairs' stretches
+        up_.push_back(0.0);
+        std::vector<double>& down_stretches = from_down_;  // scratch until the exchange
+        std::vector<double>& up_stretches = from_up_;
+        down_stretches.clear();
+        up_stretches.clear();
+        if constexpr (M::memory) {
+            // Every live pair's stretch by its key, while the ghosts' ids are still here; a migrant's pairs
+            // go with it (the rank it joins may not hold the partner).
+            for (std::size_t k = 0; k < pairs_.size() && k < live_.size(); ++k)
+                if (live_[k]) st_.pending[{p_.id[std::size_t(pairs_[k].i)], p_.id[std::size_t(pairs_[k].j)]}] = st_.pair[k];
+            for (std::size_t l = 0; l < p_.owned(); ++l) {
+                const int to = plan_.slabs.owner(axis_coordinate(l));
+                if (to == me || row_start_.size() <= l + 1) continue;
+                for (std::size_t e = row_start_[l]; e < row_start_[l + 1]; ++e) {
+                    const std::size_t k = std::size_t(rows_[e].pair);
+                    if (k < live_.size() && live_[k])
+                        pack_stretch(to < me ? down_stretches : up_stretches, p_.id[std::size_t(pairs_[k].i)],
+                                     p_.id[std::size_t(pairs_[k].j)], st_.pair[k]);
+                }
+            }
+        }
+        p_.drop_ghosts();
+        for (std::size_t l = 0; l < p_.owned();) {
+            const int to = plan_.slabs.owner(axis_coordinate(l));
+            if (to == me) {
+                ++l;
+                continue;
+            }
+            if (to != me - 1 && to != me + 1)
+                throw InstabilityError(fmt::format("particle {} moved across more than one slab in a step (from rank {} to {}): the run "
+                                                   "has blown up", p_.id[l], me, to), -1, p_.id[l]);
+            std::vector<double>& out = to < me ? down_ : up_;
+            p_.pack_migrant(l, out);
+            out[0] += 1.0;
+            if constexpr (M::memory) {
+                st_.pack_wall_row(l, out);
+                st_.move_owned(p_.owned() - 1, l);
+            }
+            p_.remove_owned(l);
+            if constexpr (M::memory) st_.resize_owned(p_.owned());
+            ++migrants_;
+        }
+        down_.insert(down_.end(), down_stretches.begin(), down_stretches.end());
+        up_.insert(up_.end(), up_stretches.begin(), up_stretches.end());
+        comm_.exchange(down_, up_, from_down_, from_up_, 1);
+        for (const std::vector<double>* in : {&from_down_, &from_up_}) {
+            if (in->empty()) continue;
+            const std::size_t n = std::size_t((*in)[0]);
+            for (std::size_t k = 0; k < n; ++k) {
+                const double* q = &(*in)[1 + k * record];
+                p_.add_migrant(q);
+                if constexpr (M::memory) {
+                    st_.resize_owned(p_.owned());
+                    st_.set_wall_row(p_.owned() - 1, q + kMigrantDoubles);
+                }
+            }
+            if constexpr (M::memory)
+                for (std::size_t at = 1 + n * record; at + kStretchDoubles <= in->size(); at += kStretchDoubles) {
+                    const double* q = &(*in)[at];
+                    st_.pending[{double_to_id(q[0]), double_to_id(q[1])}] = unpack_stretch(q);
+                }
+        }
+    }
+
+    // Rank 0's state's stretches, to the ranks that own a contact's particles (both, for a pair that
+    // straddles a face); the pairs wait in `pending` for the first rebuild.
+    void load_stretches(const State& s)
+    {
+        st_.walls = walls_.size();
+        st_.resize_owned(p_.owned());
+        std::vector<std::vector<double>> parts;
+        if (comm_.root()) {
+            parts.resize(std::size_t(comm_.size()));
+            auto owner = [&](std::int64_t i) { return plan_.slabs.owner(component(s.trans.x[std::size_t(i)], plan_.slabs.axis)); };
+            for (const ContactStretch& c : s.stretches) {
+                const Stretch<double> v{c.tangential, c.rolling};
+                const int oi = owner(c.i);
+                pack_stretch(parts[std::size_t(oi)], c.i, c.wall ? -1 - c.partner : c.partner, v);
+                if (!c.wall && owner(c.partner) != oi) pack_stretch(parts[std::size_t(owner(c.partner))], c.i, c.partner, v);
+            }
+        }
+        const std::vector<double> mine = comm_.scatter(parts);
+        std::unordered_map<std::int64_t, std::size_t> local;
+        for (std::size_t l = 0; l < p_.owned(); ++l) local[p_.id[l]] = l;
+        for (std::size_t at = 0; at + kStretchDoubles <= mine.size(); at += kStretchDoubles) {
+            const double* q = &mine[at];
+            const std::int64_t i = double_to_id(q[0]), j = double_to_id(q[1]);
+            if (j < 0) {
+                const std::size_t w = std::size_t(-1 - j), l = local.at(i);
+                st_.wall_row(l)[w] = unpack_stretch(q);
+                st_.wall_live[l * walls_.size() + w] = 1;
+            } else {
+                st_.pending[{i, j}] = unpack_stretch(q);
+            }
+        }
+    }
+
+    // Every live contact's stretch once (a pair where its lower id is owned, a wall contact of an owned
+    // particle), gathered on rank 0 in the canonical order.
+    void save_stretches(State& out) const
+    {
+        std::vector<double> mine;
+        const std::size_t no = p_.owned();
+        for (std::size_t k = 0; k < pairs_.size() && k < live_.size(); ++k)
+            if (live_[k] && std::size_t(pairs_[k].i) < no)
+                pack_stretch(mine, p_.id[std::size_t(pairs_[k].i)], p_.id[std::size_t(pairs_[k].j)], st_.pair[k]);
+        for (std::size_t l = 0; l < no; ++l)
+            for (std::size_t w = 0; w < walls_.size(); ++w)
+                if (st_.wall_live[l * walls_.size() + w]) pack_stretch(mine, p_.id[l], -1 - std::int64_t(w), st_.wall[l * walls_.size() + w]);
+        const std::vector<double> all = comm_.gather(mine);
+        for (std::size_t at = 0; at + kStretchDoubles <= all.size(); at += kStretchDoubles) {
+            const double* q = &all[at];
+            const std::int64_t i = double_to_id(q[0]), j = double_to_id(q[1]);
+            const Stretch<double> v = unpack_stretch(q);
+            out.stretches.push_back({i, j < 0 ? -1 - j : j, j < 0, v.t, v.r});
+        }
+        std::sort(out.stretches.begin(), out.stretches.end());
+    }
+
+    // Copies of the owned particles within the halo of a shared face, for the neighbour across it.
+    void exchange_ghosts()
+    {
+        down_.clear();
+        up_.clear();
+        const int me = comm_.rank();
+        const double lo = plan_.slabs.cuts[std::size_t(me)], hi = plan_.slabs.cuts[std::size_t(me) + 1];
+        send_down_.clear();
+        send_up_.clear();
+        for (std::size_t l = 0; l < p_.owned(); ++l) {
+            const double c = axis_coordinate(l);
+            if (me > 0 && c - lo < plan_.halo) {
+                p_.pack_ghost(l, down_);
+                send_down_.push_back(std::int32_t(l));
+            }
+            if (me + 1 < comm_.size() && hi - c < plan_.halo) {
+                p_.pack_ghost(l, up_);
+                send_up_.push_back(std::int32_t(l));
+            }
+        }
+        comm_.exchange(down_, up_, from_down_, from_up_, 2);
+        p_.add_ghosts(from_down_);
+        p_.add_ghosts(from_up_);
+        ghosts_from_down_ = from_down_.size() / kGhostDoubles;
+        ghosts_from_up_ = from_up_.size() / kGhostDoubles;
+    }
+
+    // Between rebuilds: the same particles' position, velocity and angular velocity, in the order of the
+    // rebuild, overwrite the ghosts they made.
+    void refresh_ghosts()
+    {
+        auto pack = [&](const std::vector<std::int32_t>& list, std::vector<double>& out) {
+            out.clear();
+            for (std::int32_t l : list)
+                for (const Vec3d* q : {&p_.x[std::size_t(l)], &p_.v[std::size_t(l)], &p_.w[std::size_t(l)]})
+                    for (int c = 0; c < 3; ++c) out.push_back(component(*q, c));
+        };
+        pack(send_down_, down_);
+        pack(send_up_, up_);
+        comm_.exchange(down_, up_, from_down_, from_up_, 3);
+        auto unpack = [&](const std::vector<double>& in, std::size_t count, std::size_t first) {
+            if (in.size() != 9 * count) throw Error("internal: a neighbour refreshed a different number of ghosts");
+            for (std::size_t k = 0; k < count; ++k) {
+                const double* q = &in[9 * k];
+                p_.x[first + k] = {q[0], q[1], q[2]};
+                p_.v[first + k] = {q[3], q[4], q[5]};
+                p_.w[first + k] = {q[6], q[7], q[8]};
+            }
+        };
+        unpack(from_down_, ghosts_from_down_, p_.owned());
+        unpack(from_up_, ghosts_from_up_, p_.owned() + ghosts_from_down_);
+    }
+
+    // Has any particle on any rank moved more than 0.45 skin since the last rebuild (fast's criterion)?
+    bool must_rebuild()
+    {
+        double worst = 0.0;
+        for (std::size_t l = 0; l < p_.owned(); ++l) {
+            const Vec3d d = p_.x[l] - x_built_[l];
+            worst = std::max(worst, dot(d, d));
+        }
+        const double limit = 0.45 * plan_.skin;
+        // A NaN position compares false: rebuild, so that the cell search names the particle.
+        return comm_.any(!(worst <= limit * limit));
+    }
+
+    // Every pair with an owned particle that may_touch accepts (owned first in the local order: a pair
+    // (a, b), a < b, has an owned particle exactly when a is owned), and each owned particle's row of
+    // partners sorted by id.
+    void find_pairs()
+    {
+        const std::size_t n = p_.size(), no = p_.owned();
+        px_.resize(n);
+        py_.resize(n);
+        pz_.resize(n);
+        for (std::size_t l = 0; l < n; ++l) {
+            px_[l] = p_.x[l].x;
+            py_[l] = p_.x[l].y;
+            pz_[l] = p_.x[l].z;
+        }
+        if (n > cells_reserved_) {
+            cells_reserved_ = n + n / 4;
+            cells_.reserve(cells_reserved_);
+        }
+        pairs_.clear();
+        const double half_skin = 0.5 * plan_.skin;  // may_touch with each radius grown: pairs closer than R_i + R_j + skin
+        if (n > 0) cells_.build(n, px_.data(), py_.data(), pz_.data(), plan_.cell);
+        for (std::size_t a = 0; a < no; ++a)
+            cells_.for_each_above(a, [&](std::size_t b) {
+                if (!may_touch(p_.x[a], p_.x[b], p_.r[a] + half_skin, p_.r[b] + half_skin)) return;
+                pairs_.push_back(p_.id[a] < p_.id[b] ? Pair{std::int32_t(a), std::int32_t(b)} : Pair{std::int32_t(b), std::int32_t(a)});
+            });
+        row_start_.assign(no + 1, 0);
+        for (const Pair& q : pairs_) {
+            if (std::size_t(q.i) < no) ++row_start_[std::size_t(q.i) + 1];
+            if (std::size_t(q.j) < no) ++row_start_[std::size_t(q.j) + 1];
+        }
+        for (std::size_t l = 0; l < no; ++l) row_start_[l + 1] += row_start_[l];
+        rows_.resize(row_start_[no]);
+        fill_.assign(row_start_.begin(), row_start_.end() - 1);
+        for (std::size_t k = 0; k < pairs_.size(); ++k) {
+            const Pair& q = pairs_[k];
+            if (std::size_t(q.i) < no) rows_[fill_[std::size_t(q.i)]++] = {p_.id[std::size_t(q.j)], std::int32_t(k), true};
+            if (std::size_t(q.j) < no) rows_[fill_[std::size_t(q.j)]++] = {p_.id[std::size_t(q.i)], std::int32_t(k), false};
+        }
+        for (std::size_t l = 0; l < no; ++l)  // a few partners per row: insertion sort
+            for (std::size_t e = row_start_[l] + 1; e < row_start_[l + 1]; ++e)
+                for (std::size_t k = e; k > row_start_[l] && rows_[k - 1].partner > rows_[k].partner; --k) std::swap(rows_[k - 1], rows_[k]);
+    }
+
+    // The walls each owned particle may touch, in wall order.
+    void find_walls()
+    {
+        const std::size_t no = p_.owned();
+        wall_start_.assign(no + 1, 0);
+        wall_rows_.clear();
+        for (std::size_t l = 0; l < no; ++l) {
+            for (std::size_t w = 0; w < walls_.size(); ++w)
+                if (may_touch_wall(p_.x[l], p_.r[l], wp_[w], walls_[w].normal)) wall_rows_.push_back(std::int32_t(w));
+            wall_start_[l + 1] = wall_rows_.size();
+        }
+    }
+
+    static constexpr bool law = M::restitution_damping || M::history || M::rolling;  // a §9 law, not the paper's
+
+    Comm comm_;
+    Plan plan_;
+    MemoryParams<double> memory_;
+    RankStretches st_;  // a §9 law with memory: the stretches
+    std::int64_t step_ = 0, steps_ = 0, owned_max_ = 0, migrants_ = 0, rebuilds_ = 0;
+    bool built_ = false;
+    std::vector<Vec3d> x_built_;                         // owned positions at the last rebuild
+    std::vector<std::int32_t> send_down_, send_up_;      // the owned particles whose ghosts the neighbours hold
+    std::size_t ghosts_from_down_ = 0, ghosts_from_up_ = 0;
+    double dt_ = 0.0;
+    GearCoefficients<double> coef_;
+    ContactParams<double> params_;
+    Coefficients<double> mono_pp_, mono_pw_;
+    Vec3d g_;
+    std::vector<Wall> walls_;
+    std::vector<Vec3d> wp_;  // the walls' points at the current step
+    RankParticles p_;
+    std::vector<double> down_, up_, from_down_, from_up_;  // exchange buffers, kept between steps
+    std::vector<double> px_, py_, pz_;
+    LinkedCells cells_;
+    std::size_t cells_reserved_ = 0;
+    std::vector<Pair> pairs_;
+    std::vector<Entry> rows_;
+    std::vector<std::size_t> row_start_, fill_, wall_start_;
+    std::vector<std::int32_t> wall_rows_;
+    std::vector<ContactForce<double>> pf_;
+    std::vector<char> live_;
+    std::int64_t pp_ = 0, pw_ = 0, candidates_ = 0;
+};
+
+} // namespace demmat::mpi
