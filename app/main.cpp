@@ -468,9 +468,17 @@ struct SceneArgs {
     std::int64_t max_layers = dense_bed_max_layers;
     double speed = 0.0, gap = 0.001;  // speed 0: the kind's default
     std::vector<std::string> contact;  // --contact KEY=VALUE: the [contact] table (physics.md §9)
-    ChungOoiCase chung_ooi{0};         // chung-ooi (test 0: --test not given): --test, --material, --value, --law, --per-tc
+    ChungOoiCase chung_ooi = no_test();  // chung-ooi (test 0: --test not given): --test, --material, --value, --law, --per-tc
     bool chung_ooi_value = false;      // --value given (else the test's first)
 };
+
+// chung-ooi's case before the options: test 0 says --test was not given.
+ChungOoiCase no_test()
+{
+    ChungOoiCase c;
+    c.test = 0;
+    return c;
+}
 
 // Writes a scene only if `demmat run` would accept it: the options are checked by their validators (--n
 // >= 1, --speed > 0, --gap >= 0, finite), and the scene itself by making its initial state (particles in

@@ -336,7 +336,9 @@ TEST(Fast, EachLevelOfTheFeatureChainMatchesTheFullModelWhereItsFeaturesAreInert
         b.variant->save(sb);
         EXPECT_EQ(state_difference(sa, sb), "") << l.model;
         EXPECT_GT(contacts, 500) << l.model;  // contact-rich, so a skipped feature had work to skip
-        if (l.walls) EXPECT_GT(walls, 50) << l.model;
+        if (l.walls) {
+            EXPECT_GT(walls, 50) << l.model;
+        }
     }
 }
 

@@ -111,7 +111,9 @@ void expect_lockstep(const Problem& p, const Law& law, std::int64_t steps, std::
     EXPECT_EQ(r.saved_difference, "") << law.name;
     ASSERT_EQ(r.rebuilds.size(), kRuns.size());
     EXPECT_EQ(r.rebuilds[0], steps + 1) << "no skin: every step must rebuild";
-    if (law.memory) EXPECT_GT(r.stretched, min_stretched) << law.name << ": too few live stretches for the test to mean much";
+    if (law.memory) {
+        EXPECT_GT(r.stretched, min_stretched) << law.name << ": too few live stretches for the test to mean much";
+    }
 }
 
 std::filesystem::path save_to(const State& st, const std::string& name)
