@@ -186,7 +186,7 @@ class MemoryEquivalence : public MemoryEquivalenceBase {};
 TEST_P(MemoryEquivalence, SettlingBedIsBitIdenticalToArrays)
 {
     if (const std::string why = skip_reason(); !why.empty()) GTEST_SKIP() << why;
-    expect_identical(0.0, kCells2, 150);
+    expect_identical(0.0, kCells2, long_run(150));
 }
 
 INSTANTIATE_TEST_SUITE_P(RegistryTimesLaws, MemoryEquivalence,
@@ -197,13 +197,13 @@ class MemoryEquivalenceStages : public MemoryEquivalenceBase {};
 TEST_P(MemoryEquivalenceStages, CompressionStageIsBitIdenticalToArrays)
 {
     if (const std::string why = skip_reason(); !why.empty()) GTEST_SKIP() << why;
-    expect_identical(0.5, std::get<1>(GetParam()) == "tsuji" ? kAllPairs : kCells4, 150);
+    expect_identical(0.5, std::get<1>(GetParam()) == "tsuji" ? kAllPairs : kCells4, long_run(150));
 }
 
 TEST_P(MemoryEquivalenceStages, SaveAndContinueIsBitIdenticalToArrays)
 {
     if (const std::string why = skip_reason(); !why.empty()) GTEST_SKIP() << why;
-    expect_save_and_continue(kCells4, 80, 80);
+    expect_save_and_continue(kCells4, long_run(80), long_run(80));
 }
 
 INSTANTIATE_TEST_SUITE_P(RegistryTimesLaws, MemoryEquivalenceStages,
