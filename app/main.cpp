@@ -461,6 +461,14 @@ int cmd_bench(const BenchArgs& a)
 }
 
 // ---- demmat scene ----------------------------------------------------------------------------------------
+// chung-ooi's case before the options: test 0 says --test was not given.
+ChungOoiCase no_test()
+{
+    ChungOoiCase c;
+    c.test = 0;
+    return c;
+}
+
 struct SceneArgs {
     std::string kind, out, from, state;
     std::int64_t count = 0;  // 0: the kind's default
@@ -471,14 +479,6 @@ struct SceneArgs {
     ChungOoiCase chung_ooi = no_test();  // chung-ooi (test 0: --test not given): --test, --material, --value, --law, --per-tc
     bool chung_ooi_value = false;      // --value given (else the test's first)
 };
-
-// chung-ooi's case before the options: test 0 says --test was not given.
-ChungOoiCase no_test()
-{
-    ChungOoiCase c;
-    c.test = 0;
-    return c;
-}
 
 // Writes a scene only if `demmat run` would accept it: the options are checked by their validators (--n
 // >= 1, --speed > 0, --gap >= 0, finite), and the scene itself by making its initial state (particles in

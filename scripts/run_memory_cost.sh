@@ -1,7 +1,7 @@
 #!/usr/bin/env bash
 # What contact memory costs each style: µs per particle-step and bytes per particle of every registered
 # variant that runs the law, under the paper's law, linear_history, mindlin and mindlin + sds (physics.md
-# §9), on the settled dense bed and on the compression stage. Each law's bed is settled once with arrays
+# §9), on the settled dense bed and on the compression stage. Each law's bed is settled once with fast
 # (a state carries its law in its fingerprint, so each law settles its own); then R rounds, each timing
 # every (law, stage) with `demmat bench` (the variants interleaved inside it, one repetition), the
 # (law, stage) order rotated from round to round, so that a shared machine's drift hits all alike; the
