@@ -102,8 +102,8 @@ def write_bench(df, provenance, versions, out, figure):
              "",
              f"Median of {int(med.repetitions.max())} interleaved repetitions, one core per code. "
              f"LAMMPS {versions.get('lammps', '?')} (Debian {versions.get('lammps_package', '?')}), "
-             f"LIGGGHTS {versions.get('liggghts', '?')} (Debian {versions.get('liggghts_package', '?')}); "
-             f"suite commit {(provenance or {}).get('commit', '?')}, {(provenance or {}).get('compiler', '?')}, "
+             + (f"LIGGGHTS {versions['liggghts']} (Debian {versions.get('liggghts_package', '?')}); " if versions.get("liggghts") else "no LIGGGHTS; ")
+             + f"suite commit {(provenance or {}).get('commit', '?')}, {(provenance or {}).get('compiler', '?')}, "
              f"CPU {cpu}. Ratio < 1: faster than LAMMPS. Produced by scripts/run_peers.sh; every sample in bench_peers.json.", "",
              f"Contact law: {versions.get('contact_law', 'the paper' + chr(39) + 's (physics.md section 2)')}.", ""]
     ns = sorted(med.particles.unique())
