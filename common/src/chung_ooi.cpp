@@ -71,18 +71,10 @@ double viscous_gamma_for(double e, double mstar, double rstar, double estar, dou
             },
             1e-4);
     };
-    double lo = 0.0, hi = 1.0;
-    while (rebound(hi) > e && hi < 1e3) {
-        lo = hi;
-        hi *= 2.0;
-    }
-    while (hi - lo > 1e-10 * hi) {
-        const double mid = 0.5 * (lo + hi);
-        (rebound(mid) > e ? lo : hi) = mid;
-    }
+    const double g = damping_for_rebound(rebound, e);
     const double K = 4.0 / 3.0 * estar * std::sqrt(rstar);
     const double h0 = std::pow(mstar * v * v / K, 0.4);
-    return 0.5 * (lo + hi) / (h0 / v);
+    return g / (h0 / v);
 }
 
 double check_value(const ChungOoiTest& t, double value)

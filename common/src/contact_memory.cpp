@@ -49,17 +49,8 @@ double restitution_alpha(double e)
     if (e >= 1.0) return 0.0;
     thread_local double last_e = -1.0, last_alpha = 0.0;  // Setup::make and the t = 0 forces ask for the same e
     if (e == last_e) return last_alpha;
-    double lo = 0.0, hi = 1.0;
-    while (dimensionless_rebound(hi) > e && hi < 1e3) {
-        lo = hi;
-        hi *= 2.0;
-    }
-    while (hi - lo > 1e-10 * hi) {
-        const double mid = 0.5 * (lo + hi);
-        (dimensionless_rebound(mid) > e ? lo : hi) = mid;
-    }
+    last_alpha = damping_for_rebound(dimensionless_rebound, e);
     last_e = e;
-    last_alpha = 0.5 * (lo + hi);
     return last_alpha;
 }
 

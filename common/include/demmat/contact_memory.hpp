@@ -73,6 +73,24 @@ double head_on_rebound(Acc&& acc, double step, double max_time = 200.0)
     return 0.0;
 }
 
+// Where a rebound that falls monotonically with its damping coefficient, rebound(c), reaches e: c is
+// bracketed by doubling from 1 (up to 10³) and bisected until the bracket is narrower than 10⁻¹⁰·c. Solves
+// restitution_alpha and the Chung & Ooi scenes' viscous γ_n alike.
+template <class Rebound>
+double damping_for_rebound(Rebound&& rebound, double e)
+{
+    double lo = 0.0, hi = 1.0;
+    while (rebound(hi) > e && hi < 1e3) {
+        lo = hi;
+        hi *= 2.0;
+    }
+    while (hi - lo > 1e-10 * hi) {
+        const double mid = 0.5 * (lo + hi);
+        (rebound(mid) > e ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
 // The law as `demmat run` prints it: ContactModel::describe() and the α the run derived.
 std::string describe_law(const ContactModel& law, const MemoryParams<double>& q);
 
