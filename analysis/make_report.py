@@ -121,6 +121,40 @@ def section(rep, title, tables, figures, what, script):
             rep.image(fig, alt)
 
 
+def validation(rep):
+    """Chung & Ooi's tests: judged values passed per test and law (errors.csv), the full table linked."""
+    rep.add("## Validation: Chung & Ooi (2011) tests 1–8", "")
+    rel = "validation/errors.csv"
+    if not os.path.exists(rep.path(rel)):
+        rep.missing("the Chung & Ooi validation", "scripts/run_validation.sh")
+        return
+    import pandas as pd  # only here: the other sections need no pandas
+    df = pd.read_csv(rep.path(rel))
+    # pass/fail: judged against a reference of the same law; agrees/differs: the paper's law (no tangential
+    # spring) beside the compliant laws' reference, expected to differ (docs/validation.md); info: not judged.
+    df = df[df["pass"] != "info"]
+    laws = sorted(df.law.unique(), key=lambda l: (l != "paper", l))
+    rep.add("Per test and law, over every variant, material and integrator that ran: judged values that pass / judged; "
+            "after a semicolon, the paper's law beside the tangentially compliant reference, which it is expected "
+            "not to follow (it has no tangential spring): agrees / compared. The worst case of each quantity, its "
+            f"reference and tolerance: {rep.link('validation/table.md')}; the method: docs/validation.md.", "",
+            "| test | " + " | ".join(laws) + " |", "|---|" + "---:|" * len(laws))
+    for test, t in df.groupby("test"):
+        cells = []
+        for law in laws:
+            x = t[t.law == law]
+            judged = x[~x["pass"].isin(["agrees"]) & ~x["pass"].str.startswith("differs")]
+            compared = x[x["pass"].eq("agrees") | x["pass"].str.startswith("differs")]
+            cell = f"{int((judged['pass'] == 'pass').sum())} / {len(judged)}" if len(judged) else ""
+            if len(compared):
+                cell += f"; {int((compared['pass'] == 'agrees').sum())} / {len(compared)}"
+            cells.append(cell)
+        rep.add(f"| {test} | " + " | ".join(cells) + " |")
+    rep.add("")
+    for k in range(1, 9):
+        rep.image(f"validation/test{k}.png", f"Chung & Ooi test {k}")
+
+
 def build(root, out, paper):
     rep = Report(root, out)
     rep.add("# demmat: the results", "",
@@ -139,6 +173,20 @@ def build(root, out, paper):
     section(rep, "Validation: the physics beside LAMMPS and LIGGGHTS", [physics],
             [(n and f"figures/peers_physics_{n}.png", "Physics cross-check")],
             "the ensemble cross-check of the physics against LAMMPS and LIGGGHTS", "scripts/run_peers.sh")
+    section(rep, "Beside LAMMPS with contact memory (tangential mindlin): time per step", ["peers_mindlin/bench_peers.md"],
+            [("peers_mindlin/peers_us_per_particle_step.png", "µs per particle-step against N, mindlin")],
+            "the benchmark beside LAMMPS with a law of physics.md §9", "scripts/run_peers.sh --contact \"tangential=mindlin ...\"")
+    physics_law = newest(root, "peers_mindlin/physics_*.md")
+    section(rep, "The physics beside LAMMPS with contact memory (tangential mindlin)", [physics_law],
+            [(physics_law and physics_law.replace("physics_", "peers_physics_").replace(".md", ".png"), "Physics cross-check, mindlin")],
+            "the ensemble cross-check with a law of physics.md §9", "scripts/run_peers.sh --contact \"tangential=mindlin ...\"")
+    section(rep, "What contact memory costs each style", ["memory_cost/table.md"], [("memory_cost/memory_cost.png", "memory cost")],
+            "the cost of contact memory per style", "scripts/run_memory_cost.sh")
+    validation(rep)
+    section(rep, "Distributed memory: the mpi variant", ["mpi/bench_mpi.md", "mpi/halo_mpi.md", "mpi/imbalance_mpi.md"], [],
+            "the mpi benchmark, halo traffic and imbalance", "scripts/run_mpi_bench.sh")
+    if os.path.exists(rep.path("mpi/scaling.md")):
+        rep.add(f"The scaling model from these measurements: {rep.link('mpi/scaling.md')}.", "")
     section(rep, "Accuracy: error against time step and CPU time", ["accuracy/recommendation.md"],
             [("figures/accuracy_work_precision.png", "work–precision"), ("figures/accuracy_error_vs_dt.png", "error against Δt")],
             "the speed–accuracy study", "scripts/run_accuracy.sh")
