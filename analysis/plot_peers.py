@@ -189,8 +189,13 @@ def cmd_observables(a):
 
 
 # ---- physics -----------------------------------------------------------------------------------------------
-CODE_STYLE = {"suite": ("tab:blue", "suite (arrays, Gear)"), "lammps": ("black", "LAMMPS (velocity Verlet)"),
+CODE_STYLE = {"suite": ("tab:blue", "suite (arrays, Gear)"),
+              "suite_verlet": ("tab:green", "suite (arrays, velocity Verlet)"),
+              "lammps": ("black", "LAMMPS (velocity Verlet)"),
               "liggghts": ("tab:orange", "LIGGGHTS 3.8 (hertz/stiffness)")}
+# suite_verlet: the suite's law with LAMMPS's integrator family, so that the table can tell how much of
+# the suite's distance from LAMMPS is the integrator and how much the law's details (docs/peers.md).
+RELATIVE_TO_LAMMPS = ("suite", "suite_verlet")
 
 
 def cmd_physics(a):
@@ -234,7 +239,9 @@ def write_physics(df, versions, particles, amplitude, out, figure):
     lines = [f"# Physics cross-check: the suite, LAMMPS and LIGGGHTS from the same {particles} grains", "",
              f"Each code ran {df.member.nunique()} perturbed starts (velocities ± {amplitude} m/s, the same data files for "
              f"every code). Mean ± standard deviation over the ensemble; *z* = (code − LAMMPS) / pooled std. "
-             f"LAMMPS {versions.get('lammps', '?')}, LIGGGHTS {versions.get('liggghts', '?')}. Produced by scripts/run_peers.sh. "
+             f"LAMMPS {versions.get('lammps', '?')}, "
+             + (f"LIGGGHTS {versions.get('liggghts', '?')}. " if "liggghts" in df.code.unique() else "LIGGGHTS not run. ")
+             + "Produced by scripts/run_peers.sh. "
              f"Where the perturbations have not yet grown (the short compression window), the ensemble band is "
              f"narrower than the codes' systematic differences and z is large for differences of 0.1 %: read the "
              f"relative difference there (docs/peers.md explains the causes).", ""]
@@ -242,21 +249,24 @@ def write_physics(df, versions, particles, amplitude, out, figure):
         s = df[df.stage == stage]
         times = sorted(s.time.unique())
         picks = [times[len(times) // 4], times[len(times) // 2], times[-1]]
-        lines += [f"## {title}", "", "| t (s) | " + " | ".join(CODE_STYLE[c][1] for c in ("suite", "lammps", "liggghts") if c in s.code.unique())
-                  + " | suite − LAMMPS | z suite | z LIGGGHTS |", "|---:|" + "---:|" * (s.code.nunique() + 3)]
+        codes = [c for c in CODE_STYLE if c in s.code.unique()]
+        rel_codes = [c for c in RELATIVE_TO_LAMMPS if c in codes and "lammps" in codes]
+        z_codes = [c for c in codes if c != "lammps" and "lammps" in codes]
+        lines += [f"## {title}", "",
+                  "| t (s) | " + " | ".join(CODE_STYLE[c][1] for c in codes)
+                  + "".join(f" | {CODE_STYLE[c][1].replace('suite (arrays, ', 'suite (')} − LAMMPS" for c in rel_codes)
+                  + "".join(f" | z {CODE_STYLE[c][1]}" for c in z_codes) + " |",
+                  "|---:|" + "---:|" * (len(codes) + len(rel_codes) + len(z_codes))]
         for t in picks:
             at = s[s.time == t].groupby("code")[q]
             mean, std = at.mean(), at.std(ddof=1)
-            cells = [f"{mean[c]:.4g} ± {std[c]:.2g}" for c in ("suite", "lammps", "liggghts") if c in mean.index]
-
-            def z(c):
-                if c not in mean.index or "lammps" not in mean.index:
-                    return ""
+            cells = [f"{mean[c]:.4g} ± {std[c]:.2g}" for c in codes]
+            cells += [f"{100.0 * (mean[c] - mean['lammps']) / abs(mean['lammps']):+.2f} %" if mean["lammps"] != 0 else ""
+                      for c in rel_codes]
+            for c in z_codes:
                 pooled = math.sqrt(0.5 * (std[c] ** 2 + std["lammps"] ** 2))
-                return f"{(mean[c] - mean['lammps']) / pooled:+.1f}" if pooled > 0 else "n/a"
-            rel = (f"{100.0 * (mean['suite'] - mean['lammps']) / abs(mean['lammps']):+.2f} %"
-                   if "suite" in mean.index and "lammps" in mean.index and mean["lammps"] != 0 else "")
-            lines.append(f"| {t:.3f} | " + " | ".join(cells) + f" | {rel} | {z('suite')} | {z('liggghts')} |")
+                cells.append(f"{(mean[c] - mean['lammps']) / pooled:+.1f}" if pooled > 0 else "n/a")
+            lines.append(f"| {t:.3f} | " + " | ".join(cells) + " |")
         lines.append("")
     write_text(os.path.join(out, f"physics_{particles}.md"), "\n".join(lines))
     print(f"results: {os.path.join(out, f'physics_{particles}.md')}, {figure}")

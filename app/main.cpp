@@ -46,22 +46,6 @@ std::vector<NamedPath> scene_inputs(const Scene& s)
     return in;
 }
 
-// --integrator/--precision: they replace the scene's [integrator] before anything depends on it (the
-// time-step check compares Δt with the chosen integrator's stability limit).
-void override_integrator(Scene& s, const std::string& integrator, const std::string& precision)
-{
-    if (!integrator.empty()) {
-        const auto k = parse_integrator(integrator);
-        if (!k) throw Error(fmt::format("unknown integrator '{}' (expected {})", integrator, integrator_names));
-        s.integrator.scheme = *k;
-    }
-    if (!precision.empty()) {
-        const auto p = parse_precision(precision);
-        if (!p) throw Error(fmt::format("unknown precision '{}' (expected {})", precision, precision_names));
-        s.integrator.precision = *p;
-    }
-}
-
 // The problem of a scene file, validated. `prepare` runs on the scene before its state is made and Δt
 // is checked: a command's overrides of the scene and the checks of its output paths, which must fail
 // before any long work.

@@ -24,7 +24,7 @@ struct PeerCommands::Args {
     CLI::App* exp = nullptr;
     CLI::App* imp = nullptr;
     CLI::App* dump = nullptr;
-    std::string scene, state, out, variant = "arrays";
+    std::string scene, state, out, variant = "arrays", integrator;
     double perturb = 0.0, skin = 0.0;
     std::uint64_t seed = 1;
     std::int64_t steps = 1000, every = 100;
@@ -55,6 +55,7 @@ PeerCommands::PeerCommands(CLI::App& app) : a_(std::make_unique<Args>())
     a.dump->add_option("--steps,-n", a.steps, "Number of steps")->check(integer_in(1, kMaxSteps));
     a.dump->add_option("--every", a.every, "Steps between frames (the first frame is the initial state; frames carry the "
                                            "scene's step, continued from a state file's)")->check(integer_in(1, kMaxSteps));
+    a.dump->add_option("--integrator", a.integrator, "gear5 | gear3 | verlet | symplectic_euler (overrides the scene's [integrator])");
     a.dump->add_option("--out,-o", a.out, "Dump file to write")->required();
 }
 
@@ -119,9 +120,11 @@ int cmd_import(const std::string& file, const std::string& scene_file, const std
     return 0;
 }
 
-int cmd_dump(const std::string& scene_file, const std::string& state_file, const std::string& variant_name, std::int64_t steps, std::int64_t every, const std::string& out)
+int cmd_dump(const std::string& scene_file, const std::string& state_file, const std::string& variant_name, const std::string& integrator,
+             std::int64_t steps, std::int64_t every, const std::string& out)
 {
     Scene scene = load_scene(scene_file);
+    override_integrator(scene, integrator, {});
     use_state_file(scene, state_file);
     check_output_path(out, "--out", inputs_of(scene));
     check_output_path(out + ".part", "--out", inputs_of(scene));
@@ -170,7 +173,7 @@ int PeerCommands::dispatch()
     const Args& a = *a_;
     if (*a.exp) return cmd_export(a.scene, a.state, a.out, a.perturb, a.seed, a.skin);
     if (*a.imp) return cmd_import(a.state, a.scene, a.out);
-    if (*a.dump) return cmd_dump(a.scene, a.state, a.variant, a.steps, a.every, a.out);
+    if (*a.dump) return cmd_dump(a.scene, a.state, a.variant, a.integrator, a.steps, a.every, a.out);
     return -1;
 }
 

@@ -174,11 +174,13 @@ if [[ $do_phys == 1 ]]; then
       $demmat export-lammps "$d/$stage.toml" -o "$base.data" --perturb "$amplitude" --seed "$m"
       $demmat import-lammps "$base.data" --scene "$d/$stage.toml" -o "$base.state"
       $demmat dump "$d/$stage.toml" --state "$base.state" --steps "$k" --every "$e" -o "$base.suite.dump" 2>/dev/null
+      # The same law with velocity Verlet: how much of the suite's distance from LAMMPS is the integrator.
+      $demmat dump "$d/$stage.toml" --state "$base.state" --integrator verlet --steps "$k" --every "$e" -o "$base.suite_verlet.dump" 2>/dev/null
       (cd "$p" && $lmp -var frag "$(basename "$base").lammps" -var steps "$k" -var every "$e" -var dumpfile "$(basename "$base").lammps.dump" \
          -in "$OLDPWD/peers/lammps/in.trace" -log none -nocite > /dev/null 2>&1)
       [[ -n "$liggghts" ]] && (cd "$p" && $liggghts -var frag "$(basename "$base").liggghts" -var steps "$k" -var every "$e" \
          -var dumpfile "$(basename "$base").liggghts.dump" -in "$OLDPWD/peers/liggghts/in.trace" -log none -nocite > /dev/null 2>&1)
-      for code in suite lammps liggghts; do
+      for code in suite suite_verlet lammps liggghts; do
         [[ -f $base.$code.dump ]] || continue
         $PYTHON analysis/plot_peers.py observables --dump "$base.$code.dump" --scene "$d/$stage.toml" \
           --code "$code" --member "$m" --stage "$stage" -o "$p/obs_${stage}_${code}_m$m.csv"

@@ -455,6 +455,20 @@ Scene parse_scene(const std::string& text, const std::string& label)
     return s;
 }
 
+void override_integrator(Scene& s, const std::string& integrator, const std::string& precision)
+{
+    if (!integrator.empty()) {
+        const auto k = parse_integrator(integrator);
+        if (!k) throw Error(fmt::format("unknown integrator '{}' (expected {})", integrator, integrator_names));
+        s.integrator.scheme = *k;
+    }
+    if (!precision.empty()) {
+        const auto p = parse_precision(precision);
+        if (!p) throw Error(fmt::format("unknown precision '{}' (expected {})", precision, precision_names));
+        s.integrator.precision = *p;
+    }
+}
+
 Scene load_scene(const std::filesystem::path& file)
 {
     Scene s = parse_scene(read_input_file(file, "scene file", kMaxSceneBytes), file.string());

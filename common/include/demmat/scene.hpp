@@ -118,6 +118,10 @@ struct Scene {
 inline constexpr std::uintmax_t kMaxSceneBytes = std::uintmax_t(1) << 30;
 
 Scene load_scene(const std::filesystem::path& file);
+// A command's --integrator/--precision (either may be empty: unchanged), replacing the scene's
+// [integrator] before anything depends on it (the time-step check compares Δt with the chosen scheme's
+// stability limit); an unknown name is a one-line error.
+void override_integrator(Scene& s, const std::string& integrator, const std::string& precision);
 Scene parse_scene(const std::string& toml_text, const std::string& label);
 std::string scene_to_toml(const Scene& scene);
 
