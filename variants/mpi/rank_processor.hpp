@@ -12,14 +12,17 @@
 //            R_i + R_j + skin. Between rebuilds, communicate only refreshes the ghosts (position,
 //            velocity, angular velocity of the same particles, in the same order). A particle moves
 //            less than half the skin between rebuilds, so the list holds every contact (the law decides)
-//   forces   each pair's force once per rank, by the shared law with the lower id as i; each owned
-//            particle's sum in the canonical order (partners ascending by id, then walls in order)
+//   forces   each pair's force once per rank, by the shared law with the lower id as i: under the
+//            paper's law by the shared pair kernel on lanes (rank_pair_kernel.hpp, fast's kernel), under
+//            a law of physics.md §9 by the scalar law; each owned particle's sum in the canonical order
+//            (partners ascending by id, then walls in order)
 //   correct  the Gear corrector on the owned particles
 //
 // A pair that straddles a face is computed by both ranks from the same inputs (the same bits); no force
 // is sent back. So every owned particle receives exactly the terms arrays gives it, in arrays' order.
 #include <algorithm>
 #include <cstdint>
+#include <memory>
 #include <unordered_map>
 #include <vector>
 
@@ -27,6 +30,7 @@
 
 #include "comm.hpp"
 #include "mpi_variant.hpp"
+#include "rank_pair_kernel.hpp"
 #include "rank_particles.hpp"
 #include "rank_stretches.hpp"
 #include "slabs.hpp"
@@ -70,6 +74,7 @@ public:
             mono_pp_ = pair_coefficients(plan_.r0, plan_.r0, plan_.m0, plan_.m0, params_);
             mono_pw_ = wall_coefficients(plan_.r0, plan_.m0, params_);
         }
+        if constexpr (!law) kernel_.init(params_, mono_pp_);
         // Rank 0 holds the whole state: each rank receives its slab's particles as migrants.
         std::vector<std::vector<double>> parts;
         if (comm_.root()) {
@@ -137,42 +142,42 @@ public:
 
     void forces() override
     {
-        const std::size_t np = pairs_.size();
-        pf_.resize(np);
-        live_.resize(np);
-        pp_ = 0;
         pw_ = 0;
-        candidates_ = 0;
         const std::size_t no = p_.owned();
-        for (std::size_t k = 0; k < np; ++k) {
-            const auto [i, j] = pairs_[k];
-            if constexpr (law) {  // a §9 law: the pair's stretch in and out (none to carry for restitution damping alone)
-                Stretch<double> s{};
-                if constexpr (M::memory) s = st_.pair[k];
-                live_[k] = particle_contact_memory<M>(p_.x[i], p_.x[j], p_.v[i], p_.v[j], p_.w[i], p_.w[j], p_.r[i], p_.r[j], p_.m[i],
-                                                      p_.m[j], params_, memory_, s, true, pf_[k]);
-                if constexpr (M::memory) st_.pair[k] = live_[k] ? s : Stretch<double>{};
-            } else {
-                live_[k] = particle_contact<M>(p_.x[i], p_.x[j], p_.v[i], p_.v[j], p_.w[i], p_.w[j], p_.r[i], p_.r[j], p_.m[i], p_.m[j],
-                                               params_, mono_pp_, pf_[k]);
-            }
-            if (std::size_t(i) < no) {  // counted where the lower id is owned: once over all ranks
-                ++candidates_;
-                if (live_[k]) ++pp_;
-            }
+        if constexpr (law) {
+            law_pairs();
+        } else {
+            pp_ = kernel_.run(p_);
+            candidates_ = std::int64_t(counted_pairs_);
         }
         for (std::size_t l = 0; l < no; ++l) {
             Vec3d f{}, t{};
-            for (std::size_t e = row_start_[l]; e < row_start_[l + 1]; ++e) {
-                const Entry& en = rows_[e];
-                if (!live_[std::size_t(en.pair)]) continue;  // a pair the law rejects adds nothing, not even a zero
-                const ContactForce<double>& c = pf_[std::size_t(en.pair)];
-                if (en.lower) {
-                    f = f + c.f_i;
-                    if constexpr (M::rotation) t = t + c.t_i;
-                } else {
-                    f = f + (-c.f_i);
-                    if constexpr (M::rotation) t = t + c.t_j;
+            if constexpr (law) {
+                for (std::size_t e = row_start_[l]; e < row_start_[l + 1]; ++e) {
+                    const Entry& en = rows_[e];
+                    if (!live_[std::size_t(en.pair)]) continue;  // a pair the law rejects adds nothing, not even a zero
+                    const ContactForce<double>& c = pf_[std::size_t(en.pair)];
+                    if (en.lower) {
+                        f = f + c.f_i;
+                        if constexpr (M::rotation) t = t + c.t_i;
+                    } else {
+                        f = f + (-c.f_i);
+                        if constexpr (M::rotation) t = t + c.t_j;
+                    }
+                }
+            } else {
+                // Every listed pair's slot, zeros out of contact: they add nothing (a sum that starts
+                // at +0 is never -0, and x + ±0 = x), so the bits are those of skipping the pair.
+                for (std::size_t e = row_start_[l]; e < row_start_[l + 1]; ++e) {
+                    const Entry& en = rows_[e];
+                    const fast::Slot& c = kernel_.slot(std::size_t(en.pair));
+                    if (en.lower) {
+                        f = f + c.f;
+                        if constexpr (M::rotation) t = t + c.ti;
+                    } else {
+                        f = f + (-c.f);
+                        if constexpr (M::rotation) t = t + c.tj;
+                    }
                 }
             }
             if constexpr (M::walls) {
@@ -274,7 +279,7 @@ public:
     {
         return p_.memory_bytes() + st_.memory_bytes() + pairs_.capacity() * sizeof(Pair) + rows_.capacity() * sizeof(Entry) +
                (row_start_.capacity() + wall_start_.capacity()) * sizeof(std::size_t) + wall_rows_.capacity() * sizeof(std::int32_t) +
-               pf_.capacity() * sizeof(ContactForce<double>) + live_.capacity() + cells_.memory_bytes();
+               pf_.capacity() * sizeof(ContactForce<double>) + live_.capacity() + cells_.memory_bytes() + kernel_.memory_bytes();
     }
     ModelFeatures model() const override { return ModelFeatures::of<M>(); }
 
@@ -297,6 +302,28 @@ private:
         std::int32_t pair;
         bool lower;            // this particle is the pair's i (the lower id)
     };
+
+    // A law of physics.md §9: each listed pair through the scalar law, its stretch in and out.
+    void law_pairs()
+    {
+        const std::size_t np = pairs_.size(), no = p_.owned();
+        pf_.resize(np);
+        live_.resize(np);
+        pp_ = 0;
+        candidates_ = 0;
+        for (std::size_t k = 0; k < np; ++k) {
+            const auto [i, j] = pairs_[k];
+            Stretch<double> s{};  // none to carry for restitution damping alone
+            if constexpr (M::memory) s = st_.pair[k];
+            live_[k] = particle_contact_memory<M>(p_.x[i], p_.x[j], p_.v[i], p_.v[j], p_.w[i], p_.w[j], p_.r[i], p_.r[j], p_.m[i], p_.m[j],
+                                                  params_, memory_, s, true, pf_[k]);
+            if constexpr (M::memory) st_.pair[k] = live_[k] ? s : Stretch<double>{};
+            if (std::size_t(i) < no) {  // counted where the lower id is owned: once over all ranks
+                ++candidates_;
+                if (live_[k]) ++pp_;
+            }
+        }
+    }
 
     // f(c) for the three components, c(v) being v.x, v.y or v.z (no run-time branch per value).
     template <class F>
@@ -533,6 +560,11 @@ private:
                 if (!may_touch(p_.x[a], p_.x[b], p_.r[a] + half_skin, p_.r[b] + half_skin)) return;
                 pairs_.push_back(p_.id[a] < p_.id[b] ? Pair{std::int32_t(a), std::int32_t(b)} : Pair{std::int32_t(b), std::int32_t(a)});
             });
+        // The pairs whose lower id this rank owns first: they are counted here, the others on the rank
+        // that owns it.
+        const auto counted = std::stable_partition(pairs_.begin(), pairs_.end(), [no](const Pair& q) { return std::size_t(q.i) < no; });
+        counted_pairs_ = std::size_t(counted - pairs_.begin());
+        if constexpr (!law) kernel_.set_pairs(pairs_, counted_pairs_);
         row_start_.assign(no + 1, 0);
         for (const Pair& q : pairs_) {
             if (std::size_t(q.i) < no) ++row_start_[std::size_t(q.i) + 1];
@@ -594,6 +626,13 @@ private:
     std::vector<ContactForce<double>> pf_;
     std::vector<char> live_;
     std::int64_t pp_ = 0, pw_ = 0, candidates_ = 0;
+    std::size_t counted_pairs_ = 0;   // pairs_[0, counted_pairs_): the lower id is owned here
+    RankPairKernel<M> kernel_;        // the paper's law: the pairs on lanes
 };
+
+// The instantiations, in two translation units compiled side by side: the paper's law on with_model's
+// models (rank_paper.cpp) and the laws of physics.md §9 on the full model (rank_laws.cpp).
+std::unique_ptr<MpiVariant> make_rank_processor_paper(const ModelFeatures& need, const Comm& comm, const Plan& plan);
+std::unique_ptr<MpiVariant> make_rank_processor_law(const ModelFeatures& need, const Comm& comm, const Plan& plan);
 
 } // namespace demmat::mpi
