@@ -16,7 +16,7 @@
 //            paper's law by the shared pair kernel on lanes (rank_pair_kernel.hpp, fast's kernel), under
 //            a law of physics.md §9 by the scalar law; each owned particle's sum in the canonical order
 //            (partners ascending by id, then walls in order)
-//   correct  the Gear corrector on the owned particles
+//   correct  the Gear corrector on the owned particles, fused into the next predict's pass (rank_gear.hpp)
 //
 // A pair that straddles a face is computed by both ranks from the same inputs (the same bits); no force
 // is sent back. So every owned particle receives exactly the terms arrays gives it, in arrays' order.
@@ -30,6 +30,7 @@
 
 #include "comm.hpp"
 #include "mpi_variant.hpp"
+#include "rank_gear.hpp"
 #include "rank_pair_kernel.hpp"
 #include "rank_particles.hpp"
 #include "rank_stretches.hpp"
@@ -100,18 +101,17 @@ public:
         migrants_ = 0;
         rebuilds_ = 0;
         built_ = false;
+        corrector_pending_ = false;
     }
 
+    // The pending corrector of the last step fused with this step's predictor, and the displacement
+    // check (rank_gear.hpp).
     void predict(std::int64_t step) override
     {
         step_ = step;
-        for (std::size_t l = 0; l < p_.owned(); ++l) {
-            each_component([&](auto c) {
-                Gear5Scheme::predict(c(p_.x[l]), c(p_.v[l]), c(p_.a[l]), c(p_.b3[l]), c(p_.b4[l]), c(p_.b5[l]), coef_);
-                if constexpr (M::rotation)
-                    Gear5Scheme::predict(c(p_.th[l]), c(p_.w[l]), c(p_.al[l]), c(p_.q3[l]), c(p_.q4[l]), c(p_.q5[l]), coef_);
-            });
-        }
+        const double limit = 0.45 * plan_.skin;
+        moved_far_ = gear_pass<M::rotation>(p_, coef_, corrector_pending_, built_ ? x_built_.data() : nullptr, limit * limit);
+        corrector_pending_ = false;
         if constexpr (M::moving_walls) place_walls(step);
     }
 
@@ -214,24 +214,17 @@ public:
         }
     }
 
-    void correct() override
-    {
-        for (std::size_t l = 0; l < p_.owned(); ++l) {
-            each_component([&](auto c) {
-                Gear5Scheme::correct(c(p_.x[l]), c(p_.v[l]), c(p_.a[l]), c(p_.b3[l]), c(p_.b4[l]), c(p_.b5[l]), c(p_.acc[l]), coef_);
-                if constexpr (M::rotation)
-                    Gear5Scheme::correct(c(p_.th[l]), c(p_.w[l]), c(p_.al[l]), c(p_.q3[l]), c(p_.q4[l]), c(p_.q5[l]), c(p_.alc[l]), coef_);
-            });
-        }
-    }
+    // Pending until the next predict (its pass applies it) or a snapshot or save (they read `corrected`).
+    void correct() override { corrector_pending_ = true; }
 
     void snapshot(Snapshot& out) const override
     {
+        const RankParticles now = corrected<M::rotation>(p_, coef_, corrector_pending_);
         std::vector<double> mine;
-        mine.reserve(16 * p_.owned());
-        for (std::size_t l = 0; l < p_.owned(); ++l) {
-            mine.push_back(id_to_double(p_.id[l]));
-            for (const Vec3d* q : {&p_.x[l], &p_.v[l], &p_.w[l], &p_.f[l], &p_.t[l]})
+        mine.reserve(16 * now.owned());
+        for (std::size_t l = 0; l < now.owned(); ++l) {
+            mine.push_back(id_to_double(now.id[l]));
+            for (const Vec3d* q : {&now.x[l], &now.v[l], &now.w[l], &now.f[l], &now.t[l]})
                 for (int c = 0; c < 3; ++c) mine.push_back(component(*q, c));
         }
         const std::vector<double> all = comm_.gather(mine);
@@ -250,9 +243,10 @@ public:
 
     void save(State& out) const override
     {
+        const RankParticles now = corrected<M::rotation>(p_, coef_, corrector_pending_);
         std::vector<double> mine;
-        mine.reserve(kMigrantDoubles * p_.owned());
-        for (std::size_t l = 0; l < p_.owned(); ++l) p_.pack_migrant(l, mine);
+        mine.reserve(kMigrantDoubles * now.owned());
+        for (std::size_t l = 0; l < now.owned(); ++l) now.pack_migrant(l, mine);
         const std::vector<double> all = comm_.gather(mine);
         out = State{};
         out.step = step_;
@@ -323,15 +317,6 @@ private:
                 if (live_[k]) ++pp_;
             }
         }
-    }
-
-    // f(c) for the three components, c(v) being v.x, v.y or v.z (no run-time branch per value).
-    template <class F>
-    static void each_component(F&& f)
-    {
-        f([](auto& v) -> auto& { return v.x; });
-        f([](auto& v) -> auto& { return v.y; });
-        f([](auto& v) -> auto& { return v.z; });
     }
 
     void place_walls(std::int64_t step)
@@ -522,17 +507,8 @@ private:
     }
 
     // Has any particle on any rank moved more than 0.45 skin since the last rebuild (fast's criterion)?
-    bool must_rebuild()
-    {
-        double worst = 0.0;
-        for (std::size_t l = 0; l < p_.owned(); ++l) {
-            const Vec3d d = p_.x[l] - x_built_[l];
-            worst = std::max(worst, dot(d, d));
-        }
-        const double limit = 0.45 * plan_.skin;
-        // A NaN position compares false: rebuild, so that the cell search names the particle.
-        return comm_.any(!(worst <= limit * limit));
-    }
+    // Each rank's answer comes from its predict pass.
+    bool must_rebuild() { return comm_.any(moved_far_); }
 
     // Every pair with an owned particle that may_touch accepts (owned first in the local order: a pair
     // (a, b), a < b, has an owned particle exactly when a is owned), and each owned particle's row of
@@ -604,6 +580,8 @@ private:
     RankStretches st_;  // a §9 law with memory: the stretches
     std::int64_t step_ = 0, steps_ = 0, owned_max_ = 0, migrants_ = 0, rebuilds_ = 0;
     bool built_ = false;
+    bool corrector_pending_ = false;  // correct() was called; the next predict applies it
+    bool moved_far_ = false;          // the last predict moved some owned particle 0.45 skin from x_built_
     std::vector<Vec3d> x_built_;                         // owned positions at the last rebuild
     std::vector<std::int32_t> send_down_, send_up_;      // the owned particles whose ghosts the neighbours hold
     std::size_t ghosts_from_down_ = 0, ghosts_from_up_ = 0;
