@@ -21,6 +21,7 @@
 // A pair that straddles a face is computed by both ranks from the same inputs (the same bits); no force
 // is sent back. So every owned particle receives exactly the terms arrays gives it, in arrays' order.
 #include <algorithm>
+#include <bit>
 #include <cstdint>
 #include <memory>
 #include <unordered_map>
@@ -180,7 +181,26 @@ public:
                     }
                 }
             }
-            if constexpr (M::walls) {
+            if constexpr (M::walls && !M::memory) {
+                // Without stretches to forget, a wall that is not a candidate adds nothing: the candidates
+                // alone, in wall order.
+                for (std::size_t e = wall_start_[l]; e < wall_start_[l + 1]; ++e) {
+                    const std::size_t w = std::size_t(wall_rows_[e]);
+                    ContactForce<double> c;
+                    Stretch<double> none{};  // restitution damping alone: no stretch to carry
+                    bool live;
+                    if constexpr (law)
+                        live = wall_contact_memory<M>(p_.x[l], p_.v[l], p_.w[l], p_.r[l], p_.m[l], wp_[w], walls_[w].normal, walls_[w].velocity,
+                                                      params_, memory_, none, true, c);
+                    else
+                        live = wall_contact<M>(p_.x[l], p_.v[l], p_.w[l], p_.r[l], p_.m[l], wp_[w], walls_[w].normal, walls_[w].velocity,
+                                               params_, mono_pw_, c);
+                    if (!live) continue;
+                    ++pw_;
+                    f = f + c.f_i;
+                    if constexpr (M::rotation) t = t + c.t_i;
+                }
+            } else if constexpr (M::walls) {
                 std::size_t e = wall_start_[l];
                 for (std::size_t w = 0; w < walls_.size(); ++w) {  // in wall order; the candidates are a sorted subset
                     const bool candidate = e < wall_start_[l + 1] && std::size_t(wall_rows_[e]) == w;
@@ -562,12 +582,31 @@ private:
     // The walls each owned particle may touch, in wall order.
     void find_walls()
     {
-        const std::size_t no = p_.owned();
+        const std::size_t no = p_.owned(), nw = walls_.size();
         wall_start_.assign(no + 1, 0);
         wall_rows_.clear();
+        if (nw > 64) {  // more walls than bits: one test at a time
+            for (std::size_t l = 0; l < no; ++l) {
+                for (std::size_t w = 0; w < nw; ++w)
+                    if (may_touch_wall(p_.x[l], p_.r[l], wp_[w], walls_[w].normal)) wall_rows_.push_back(std::int32_t(w));
+                wall_start_[l + 1] = wall_rows_.size();
+            }
+            return;
+        }
+        // A bit per wall and particle, a wall at a time over all owned particles (vectorised, as fast's
+        // wall marks), then the candidates from the bits in particle order, walls in wall order.
+        near_.assign(no, 0);
+        std::uint64_t* __restrict near = near_.data();
+        const double* __restrict x = flat(p_.x);
+        const double* __restrict r = p_.r.data();
+        for (std::size_t w = 0; w < nw; ++w) {
+            const Vec3d pt = wp_[w], nrm = walls_[w].normal;
+#pragma omp simd
+            for (std::size_t l = 0; l < no; ++l)
+                near[l] |= std::uint64_t(may_touch_wall(Vec3d{x[3 * l], x[3 * l + 1], x[3 * l + 2]}, r[l], pt, nrm)) << w;
+        }
         for (std::size_t l = 0; l < no; ++l) {
-            for (std::size_t w = 0; w < walls_.size(); ++w)
-                if (may_touch_wall(p_.x[l], p_.r[l], wp_[w], walls_[w].normal)) wall_rows_.push_back(std::int32_t(w));
+            for (std::uint64_t bits = near[l]; bits != 0; bits &= bits - 1) wall_rows_.push_back(std::int32_t(std::countr_zero(bits)));
             wall_start_[l + 1] = wall_rows_.size();
         }
     }
@@ -601,6 +640,7 @@ private:
     std::vector<Entry> rows_;
     std::vector<std::size_t> row_start_, fill_, wall_start_;
     std::vector<std::int32_t> wall_rows_;
+    std::vector<std::uint64_t> near_;  // find_walls: a bit per wall that each owned particle may touch
     std::vector<ContactForce<double>> pf_;
     std::vector<char> live_;
     std::int64_t pp_ = 0, pw_ = 0, candidates_ = 0;
