@@ -1,22 +1,24 @@
 #pragma once
 // The phases on one rank (docs/variants.md, "mpi"), for model M (model.hpp), gear5 in double:
 //
-//   predict  the Gear predictor on the owned particles; moving walls placed from the step number (every
-//            rank computes the same wall positions, nothing is sent for them)
+//   predict  the pending corrector and the Gear predictor on the owned particles in one pass, and the
+//            displacement check (rank_gear.hpp); moving walls placed from the step number (every rank
+//            computes the same wall positions, nothing is sent for them)
 //   search   a neighbour list with a skin, as fast keeps one: rebuilt when some particle on some rank
 //            has moved more than 0.45 skin since the last rebuild (one allreduce of a flag per step).
 //            At a rebuild, communicate: owned particles that left the slab migrate to the neighbour (with
 //            their whole Gear history), then each rank sends its neighbours ghost copies of its particles
 //            within the interaction range plus the skin of the shared face, and remembers whom it sent;
 //            the cell search over owned and ghosts lists every pair with an owned particle closer than
-//            R_i + R_j + skin. Between rebuilds, communicate only refreshes the ghosts (position,
+//            R_i + R_j + skin (rank_list.hpp). Between rebuilds, communicate only refreshes the ghosts (position,
 //            velocity, angular velocity of the same particles, in the same order). A particle moves
 //            less than half the skin between rebuilds, so the list holds every contact (the law decides)
 //   forces   each pair's force once per rank, by the shared law with the lower id as i: under the
 //            paper's law by the shared pair kernel on lanes (rank_pair_kernel.hpp, fast's kernel), under
 //            a law of physics.md §9 by the scalar law; each owned particle's sum in the canonical order
 //            (partners ascending by id, then walls in order)
-//   correct  the Gear corrector on the owned particles, fused into the next predict's pass (rank_gear.hpp)
+//   correct  marks the Gear corrector pending: the next predict's pass applies it, snapshot and save
+//            apply it to what they gather
 //
 // A pair that straddles a face is computed by both ranks from the same inputs (the same bits); no force
 // is sent back. So every owned particle receives exactly the terms arrays gives it, in arrays' order.
@@ -32,6 +34,7 @@
 #include "comm.hpp"
 #include "mpi_variant.hpp"
 #include "rank_gear.hpp"
+#include "rank_list.hpp"
 #include "rank_pair_kernel.hpp"
 #include "rank_particles.hpp"
 #include "rank_stretches.hpp"
@@ -40,7 +43,6 @@
 #include "demmat/contact_memory.hpp"
 #include "demmat/error.hpp"
 #include "demmat/integrators.hpp"
-#include "demmat/linked_cells.hpp"
 
 namespace demmat::mpi {
 
@@ -123,9 +125,9 @@ public:
             exchange_ghosts();
             find_pairs();
             if constexpr (M::memory) {  // each new pair takes its stretch by key; the others start at zero
-                st_.pair.assign(pairs_.size(), Stretch<double>{});
-                for (std::size_t k = 0; k < pairs_.size(); ++k) {
-                    const auto it = st_.pending.find({p_.id[std::size_t(pairs_[k].i)], p_.id[std::size_t(pairs_[k].j)]});
+                st_.pair.assign(list_.pairs.size(), Stretch<double>{});
+                for (std::size_t k = 0; k < list_.pairs.size(); ++k) {
+                    const auto it = st_.pending.find({p_.id[std::size_t(list_.pairs[k].i)], p_.id[std::size_t(list_.pairs[k].j)]});
                     if (it != st_.pending.end()) st_.pair[k] = it->second;
                 }
                 st_.pending.clear();
@@ -149,13 +151,13 @@ public:
             law_pairs();
         } else {
             pp_ = kernel_.run(p_);
-            candidates_ = std::int64_t(counted_pairs_);
+            candidates_ = std::int64_t(list_.counted);
         }
         for (std::size_t l = 0; l < no; ++l) {
             Vec3d f{}, t{};
             if constexpr (law) {
-                for (std::size_t e = row_start_[l]; e < row_start_[l + 1]; ++e) {
-                    const Entry& en = rows_[e];
+                for (std::size_t e = list_.row_start[l]; e < list_.row_start[l + 1]; ++e) {
+                    const Entry& en = list_.rows[e];
                     if (!live_[std::size_t(en.pair)]) continue;  // a pair the law rejects adds nothing, not even a zero
                     const ContactForce<double>& c = pf_[std::size_t(en.pair)];
                     if (en.lower) {
@@ -169,8 +171,8 @@ public:
             } else {
                 // Every listed pair's slot, zeros out of contact: they add nothing (a sum that starts
                 // at +0 is never -0, and x + ±0 = x), so the bits are those of skipping the pair.
-                for (std::size_t e = row_start_[l]; e < row_start_[l + 1]; ++e) {
-                    const Entry& en = rows_[e];
+                for (std::size_t e = list_.row_start[l]; e < list_.row_start[l + 1]; ++e) {
+                    const Entry& en = list_.rows[e];
                     const fast::Slot& c = kernel_.slot(std::size_t(en.pair));
                     if (en.lower) {
                         f = f + c.f;
@@ -291,9 +293,9 @@ public:
     ContactCounts counts() const override { return {comm_.sum(pp_), comm_.sum(pw_), comm_.sum(candidates_)}; }
     std::size_t memory_bytes() const override
     {
-        return p_.memory_bytes() + st_.memory_bytes() + pairs_.capacity() * sizeof(Pair) + rows_.capacity() * sizeof(Entry) +
-               (row_start_.capacity() + wall_start_.capacity()) * sizeof(std::size_t) + wall_rows_.capacity() * sizeof(std::int32_t) +
-               pf_.capacity() * sizeof(ContactForce<double>) + live_.capacity() + cells_.memory_bytes() + kernel_.memory_bytes();
+        return p_.memory_bytes() + st_.memory_bytes() + list_.memory_bytes() + wall_start_.capacity() * sizeof(std::size_t) +
+               wall_rows_.capacity() * sizeof(std::int32_t) + near_.capacity() * sizeof(std::uint64_t) + pf_.capacity() * sizeof(ContactForce<double>) +
+               live_.capacity() + kernel_.memory_bytes();
     }
     ModelFeatures model() const override { return ModelFeatures::of<M>(); }
 
@@ -308,25 +310,19 @@ public:
     }
 
 private:
-    struct Pair {
-        std::int32_t i, j;  // local indices, id[i] < id[j]
-    };
-    struct Entry {
-        std::int64_t partner;  // the partner's id: the key of the canonical order
-        std::int32_t pair;
-        bool lower;            // this particle is the pair's i (the lower id)
-    };
+    using Pair = RankList::Pair;
+    using Entry = RankList::Entry;
 
     // A law of physics.md §9: each listed pair through the scalar law, its stretch in and out.
     void law_pairs()
     {
-        const std::size_t np = pairs_.size(), no = p_.owned();
+        const std::size_t np = list_.pairs.size(), no = p_.owned();
         pf_.resize(np);
         live_.resize(np);
         pp_ = 0;
         candidates_ = 0;
         for (std::size_t k = 0; k < np; ++k) {
-            const auto [i, j] = pairs_[k];
+            const auto [i, j] = list_.pairs[k];
             Stretch<double> s{};  // none to carry for restitution damping alone
             if constexpr (M::memory) s = st_.pair[k];
             live_[k] = particle_contact_memory<M>(p_.x[i], p_.x[j], p_.v[i], p_.v[j], p_.w[i], p_.w[j], p_.r[i], p_.r[j], p_.m[i], p_.m[j],
@@ -362,16 +358,16 @@ private:
         if constexpr (M::memory) {
             // Every live pair's stretch by its key, while the ghosts' ids are still here; a migrant's pairs
             // go with it (the rank it joins may not hold the partner).
-            for (std::size_t k = 0; k < pairs_.size() && k < live_.size(); ++k)
-                if (live_[k]) st_.pending[{p_.id[std::size_t(pairs_[k].i)], p_.id[std::size_t(pairs_[k].j)]}] = st_.pair[k];
+            for (std::size_t k = 0; k < list_.pairs.size() && k < live_.size(); ++k)
+                if (live_[k]) st_.pending[{p_.id[std::size_t(list_.pairs[k].i)], p_.id[std::size_t(list_.pairs[k].j)]}] = st_.pair[k];
             for (std::size_t l = 0; l < p_.owned(); ++l) {
                 const int to = plan_.slabs.owner(axis_coordinate(l));
-                if (to == me || row_start_.size() <= l + 1) continue;
-                for (std::size_t e = row_start_[l]; e < row_start_[l + 1]; ++e) {
-                    const std::size_t k = std::size_t(rows_[e].pair);
+                if (to == me || list_.row_start.size() <= l + 1) continue;
+                for (std::size_t e = list_.row_start[l]; e < list_.row_start[l + 1]; ++e) {
+                    const std::size_t k = std::size_t(list_.rows[e].pair);
                     if (k < live_.size() && live_[k])
-                        pack_stretch(to < me ? down_stretches : up_stretches, p_.id[std::size_t(pairs_[k].i)],
-                                     p_.id[std::size_t(pairs_[k].j)], st_.pair[k]);
+                        pack_stretch(to < me ? down_stretches : up_stretches, p_.id[std::size_t(list_.pairs[k].i)],
+                                     p_.id[std::size_t(list_.pairs[k].j)], st_.pair[k]);
                 }
             }
         }
@@ -457,9 +453,9 @@ private:
     {
         std::vector<double> mine;
         const std::size_t no = p_.owned();
-        for (std::size_t k = 0; k < pairs_.size() && k < live_.size(); ++k)
-            if (live_[k] && std::size_t(pairs_[k].i) < no)
-                pack_stretch(mine, p_.id[std::size_t(pairs_[k].i)], p_.id[std::size_t(pairs_[k].j)], st_.pair[k]);
+        for (std::size_t k = 0; k < list_.pairs.size() && k < live_.size(); ++k)
+            if (live_[k] && std::size_t(list_.pairs[k].i) < no)
+                pack_stretch(mine, p_.id[std::size_t(list_.pairs[k].i)], p_.id[std::size_t(list_.pairs[k].j)], st_.pair[k]);
         for (std::size_t l = 0; l < no; ++l)
             for (std::size_t w = 0; w < walls_.size(); ++w)
                 if (st_.wall_live[l * walls_.size() + w]) pack_stretch(mine, p_.id[l], -1 - std::int64_t(w), st_.wall[l * walls_.size() + w]);
@@ -530,53 +526,11 @@ private:
     // Each rank's answer comes from its predict pass.
     bool must_rebuild() { return comm_.any(moved_far_); }
 
-    // Every pair with an owned particle that may_touch accepts (owned first in the local order: a pair
-    // (a, b), a < b, has an owned particle exactly when a is owned), and each owned particle's row of
-    // partners sorted by id.
+    // The rank's neighbour list (rank_list.hpp), and under the paper's law the kernel's slots.
     void find_pairs()
     {
-        const std::size_t n = p_.size(), no = p_.owned();
-        px_.resize(n);
-        py_.resize(n);
-        pz_.resize(n);
-        for (std::size_t l = 0; l < n; ++l) {
-            px_[l] = p_.x[l].x;
-            py_[l] = p_.x[l].y;
-            pz_[l] = p_.x[l].z;
-        }
-        if (n > cells_reserved_) {
-            cells_reserved_ = n + n / 4;
-            cells_.reserve(cells_reserved_);
-        }
-        pairs_.clear();
-        const double half_skin = 0.5 * plan_.skin;  // may_touch with each radius grown: pairs closer than R_i + R_j + skin
-        if (n > 0) cells_.build(n, px_.data(), py_.data(), pz_.data(), plan_.cell);
-        for (std::size_t a = 0; a < no; ++a)
-            cells_.for_each_above(a, [&](std::size_t b) {
-                if (!may_touch(p_.x[a], p_.x[b], p_.r[a] + half_skin, p_.r[b] + half_skin)) return;
-                pairs_.push_back(p_.id[a] < p_.id[b] ? Pair{std::int32_t(a), std::int32_t(b)} : Pair{std::int32_t(b), std::int32_t(a)});
-            });
-        // The pairs whose lower id this rank owns first: they are counted here, the others on the rank
-        // that owns it.
-        const auto counted = std::stable_partition(pairs_.begin(), pairs_.end(), [no](const Pair& q) { return std::size_t(q.i) < no; });
-        counted_pairs_ = std::size_t(counted - pairs_.begin());
-        if constexpr (!law) kernel_.set_pairs(pairs_, counted_pairs_);
-        row_start_.assign(no + 1, 0);
-        for (const Pair& q : pairs_) {
-            if (std::size_t(q.i) < no) ++row_start_[std::size_t(q.i) + 1];
-            if (std::size_t(q.j) < no) ++row_start_[std::size_t(q.j) + 1];
-        }
-        for (std::size_t l = 0; l < no; ++l) row_start_[l + 1] += row_start_[l];
-        rows_.resize(row_start_[no]);
-        fill_.assign(row_start_.begin(), row_start_.end() - 1);
-        for (std::size_t k = 0; k < pairs_.size(); ++k) {
-            const Pair& q = pairs_[k];
-            if (std::size_t(q.i) < no) rows_[fill_[std::size_t(q.i)]++] = {p_.id[std::size_t(q.j)], std::int32_t(k), true};
-            if (std::size_t(q.j) < no) rows_[fill_[std::size_t(q.j)]++] = {p_.id[std::size_t(q.i)], std::int32_t(k), false};
-        }
-        for (std::size_t l = 0; l < no; ++l)  // a few partners per row: insertion sort
-            for (std::size_t e = row_start_[l] + 1; e < row_start_[l + 1]; ++e)
-                for (std::size_t k = e; k > row_start_[l] && rows_[k - 1].partner > rows_[k].partner; --k) std::swap(rows_[k - 1], rows_[k]);
+        list_.build(p_, plan_.cell, plan_.skin);
+        if constexpr (!law) kernel_.set_pairs(list_.pairs, list_.counted);
     }
 
     // The walls each owned particle may touch, in wall order.
@@ -633,18 +587,13 @@ private:
     std::vector<Vec3d> wp_;  // the walls' points at the current step
     RankParticles p_;
     std::vector<double> down_, up_, from_down_, from_up_;  // exchange buffers, kept between steps
-    std::vector<double> px_, py_, pz_;
-    LinkedCells cells_;
-    std::size_t cells_reserved_ = 0;
-    std::vector<Pair> pairs_;
-    std::vector<Entry> rows_;
-    std::vector<std::size_t> row_start_, fill_, wall_start_;
+    RankList list_;
+    std::vector<std::size_t> wall_start_;
     std::vector<std::int32_t> wall_rows_;
     std::vector<std::uint64_t> near_;  // find_walls: a bit per wall that each owned particle may touch
     std::vector<ContactForce<double>> pf_;
     std::vector<char> live_;
     std::int64_t pp_ = 0, pw_ = 0, candidates_ = 0;
-    std::size_t counted_pairs_ = 0;   // pairs_[0, counted_pairs_): the lower id is owned here
     RankPairKernel<M> kernel_;        // the paper's law: the pairs on lanes
 };
 
