@@ -14,6 +14,9 @@ if(MPI_CXX_FOUND)
   set(DEMMAT_MPI_EXPORTS ${CMAKE_CURRENT_SOURCE_DIR}/mpi/exports.map)
   target_link_options(demmat_mpi_ranks PRIVATE -Wl,--version-script=${DEMMAT_MPI_EXPORTS} -Wl,-z,defs)
   set_target_properties(demmat_mpi_ranks PROPERTIES LINK_DEPENDS ${DEMMAT_MPI_EXPORTS})
+  if(NOT OpenMP_CXX_FOUND)  # its vectorised loops are marked `omp simd`, as fast's
+    target_compile_options(demmat_mpi_ranks PRIVATE -Wno-unknown-pragmas)
+  endif()
   # What the programs call beside the ranks (the exchange, the shared problem, the lockstep check), baseline.
   add_library(demmat_mpi_variant STATIC mpi/comm.cpp mpi/share_problem.cpp mpi/lockstep.cpp)
   target_link_libraries(demmat_mpi_variant PUBLIC demmat_mpi_ranks demmat_common MPI::MPI_CXX)
