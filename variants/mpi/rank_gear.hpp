@@ -19,6 +19,7 @@ namespace demmat::mpi {
 // pass vectorises over them, as fast's does over its component blocks).
 static_assert(sizeof(Vec3d) == 3 * sizeof(double));
 inline double* flat(std::vector<Vec3d>& v) { return reinterpret_cast<double*>(v.data()); }
+inline const double* flat(const std::vector<Vec3d>& v) { return reinterpret_cast<const double*>(v.data()); }
 
 // One degree of freedom (translation or rotation) over m values: the pending corrector (accel: the
 // accelerations of the last force pass) then the predictor, or the predictor alone.

@@ -23,7 +23,6 @@
 // A pair that straddles a face is computed by both ranks from the same inputs (the same bits); no force
 // is sent back. So every owned particle receives exactly the terms arrays gives it, in arrays' order.
 #include <algorithm>
-#include <bit>
 #include <cstdint>
 #include <memory>
 #include <unordered_map>
@@ -36,6 +35,7 @@
 #include "rank_gear.hpp"
 #include "rank_list.hpp"
 #include "rank_pair_kernel.hpp"
+#include "rank_walls.hpp"
 #include "rank_particles.hpp"
 #include "rank_stretches.hpp"
 #include "slabs.hpp"
@@ -534,36 +534,7 @@ private:
     }
 
     // The walls each owned particle may touch, in wall order.
-    void find_walls()
-    {
-        const std::size_t no = p_.owned(), nw = walls_.size();
-        wall_start_.assign(no + 1, 0);
-        wall_rows_.clear();
-        if (nw > 64) {  // more walls than bits: one test at a time
-            for (std::size_t l = 0; l < no; ++l) {
-                for (std::size_t w = 0; w < nw; ++w)
-                    if (may_touch_wall(p_.x[l], p_.r[l], wp_[w], walls_[w].normal)) wall_rows_.push_back(std::int32_t(w));
-                wall_start_[l + 1] = wall_rows_.size();
-            }
-            return;
-        }
-        // A bit per wall and particle, a wall at a time over all owned particles (vectorised, as fast's
-        // wall marks), then the candidates from the bits in particle order, walls in wall order.
-        near_.assign(no, 0);
-        std::uint64_t* __restrict near = near_.data();
-        const double* __restrict x = flat(p_.x);
-        const double* __restrict r = p_.r.data();
-        for (std::size_t w = 0; w < nw; ++w) {
-            const Vec3d pt = wp_[w], nrm = walls_[w].normal;
-#pragma omp simd
-            for (std::size_t l = 0; l < no; ++l)
-                near[l] |= std::uint64_t(may_touch_wall(Vec3d{x[3 * l], x[3 * l + 1], x[3 * l + 2]}, r[l], pt, nrm)) << w;
-        }
-        for (std::size_t l = 0; l < no; ++l) {
-            for (std::uint64_t bits = near[l]; bits != 0; bits &= bits - 1) wall_rows_.push_back(std::int32_t(std::countr_zero(bits)));
-            wall_start_[l + 1] = wall_rows_.size();
-        }
-    }
+    void find_walls() { list_wall_candidates(p_, walls_, wp_, wall_start_, wall_rows_, near_); }
 
     static constexpr bool law = M::restitution_damping || M::history || M::rolling;  // a §9 law, not the paper's
 
