@@ -1,10 +1,10 @@
 #!/usr/bin/python3
 """No instruction beyond the x86-64 baseline in the linked programs (variants/CMakeLists.txt, "fast").
 
-The fast variant alone is compiled for this CPU, as a shared object that keeps its code, and its native
-copies of the inline and template code it shares with the others, to itself. Every function the linked
-programs hold must therefore be baseline code: this disassembles each program given and fails, naming
-the functions, on any AVX register (ymm, zmm, the mask registers k0-k7), any VEX- or EVEX-encoded
+The fast variant and the mpi variant's ranks alone are compiled for this CPU, each as a shared object
+that keeps its code, and its native copies of the inline and template code it shares with the others,
+to itself. Every function the linked programs hold must therefore be baseline code: this disassembles
+each program given and fails, naming the functions, on any AVX register (ymm, zmm, the mask registers k0-k7), any VEX- or EVEX-encoded
 instruction (mnemonics v..., whatever the register), or an instruction of the extensions after the
 baseline that GCC emits without vectors (BMI, BMI2, POPCNT, LZCNT, MOVBE, ADX).
 

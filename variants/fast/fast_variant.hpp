@@ -25,18 +25,18 @@
 #include <utility>
 #include <vector>
 
-#include "canonical_sums.hpp"
-#include "canonical_sweep.hpp"
-#include "cell_order.hpp"
 #include "demmat/error.hpp"
 #include "demmat/features.hpp"
+#include "demmat/soa/canonical_sums.hpp"
+#include "demmat/soa/canonical_sweep.hpp"
+#include "demmat/soa/cell_order.hpp"
+#include "demmat/soa/neighbour_list.hpp"
+#include "demmat/soa/pair_stretches.hpp"
+#include "demmat/soa/particles.hpp"
+#include "demmat/soa/team.hpp"
+#include "demmat/soa/wall_contacts.hpp"
 #include "fast.hpp"
-#include "neighbour_list.hpp"
-#include "pair_stretches.hpp"
-#include "particles.hpp"
-#include "team.hpp"
 #include "unordered_forces.hpp"
-#include "wall_contacts.hpp"
 
 namespace demmat::fast {
 

@@ -9,12 +9,12 @@
 #include <utility>
 #include <vector>
 
-#include "heap_bytes.hpp"
-#include "neighbour_list.hpp"
-#include "pair_kernel.hpp"
-#include "particles.hpp"
-#include "team.hpp"
-#include "wall_contacts.hpp"
+#include "demmat/soa/heap_bytes.hpp"
+#include "demmat/soa/neighbour_list.hpp"
+#include "demmat/soa/pair_kernel.hpp"
+#include "demmat/soa/particles.hpp"
+#include "demmat/soa/team.hpp"
+#include "demmat/soa/wall_contacts.hpp"
 
 namespace demmat::fast {
 

@@ -85,9 +85,7 @@ public:
         need.restitution_damping = law.restitution_damping;
         need.history = law.history;
         need.rolling = law.rolling;
-        impl_ = with_law_model(need, [&]<class M>() -> std::unique_ptr<MpiVariant> {
-            return std::make_unique<RankProcessor<M>>(comm_, plan);
-        });
+        impl_ = need.beyond_paper() ? make_rank_processor_law(need, comm_, plan) : make_rank_processor_paper(need, comm_, plan);
         impl_->init(setup);
     }
     bool supports(const ContactModel&) const override { return true; }  // every law of physics.md §9

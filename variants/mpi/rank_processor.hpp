@@ -1,25 +1,30 @@
 #pragma once
 // The phases on one rank (docs/variants.md, "mpi"), for model M (model.hpp), gear5 in double:
 //
-//   predict  the Gear predictor on the owned particles; moving walls placed from the step number (every
-//            rank computes the same wall positions, nothing is sent for them)
+//   predict  the pending corrector and the Gear predictor on the owned particles in one pass, and the
+//            displacement check (rank_gear.hpp); moving walls placed from the step number (every rank
+//            computes the same wall positions, nothing is sent for them)
 //   search   a neighbour list with a skin, as fast keeps one: rebuilt when some particle on some rank
 //            has moved more than 0.45 skin since the last rebuild (one allreduce of a flag per step).
 //            At a rebuild, communicate: owned particles that left the slab migrate to the neighbour (with
 //            their whole Gear history), then each rank sends its neighbours ghost copies of its particles
 //            within the interaction range plus the skin of the shared face, and remembers whom it sent;
 //            the cell search over owned and ghosts lists every pair with an owned particle closer than
-//            R_i + R_j + skin. Between rebuilds, communicate only refreshes the ghosts (position,
+//            R_i + R_j + skin (rank_list.hpp). Between rebuilds, communicate only refreshes the ghosts (position,
 //            velocity, angular velocity of the same particles, in the same order). A particle moves
 //            less than half the skin between rebuilds, so the list holds every contact (the law decides)
-//   forces   each pair's force once per rank, by the shared law with the lower id as i; each owned
-//            particle's sum in the canonical order (partners ascending by id, then walls in order)
-//   correct  the Gear corrector on the owned particles
+//   forces   each pair's force once per rank, by the shared law with the lower id as i: under the
+//            paper's law by the shared pair kernel on lanes (rank_pair_kernel.hpp, fast's kernel), under
+//            a law of physics.md §9 by the scalar law; each owned particle's sum in the canonical order
+//            (partners ascending by id, then walls in order)
+//   correct  marks the Gear corrector pending: the next predict's pass applies it, snapshot and save
+//            apply it to what they gather
 //
 // A pair that straddles a face is computed by both ranks from the same inputs (the same bits); no force
 // is sent back. So every owned particle receives exactly the terms arrays gives it, in arrays' order.
 #include <algorithm>
 #include <cstdint>
+#include <memory>
 #include <unordered_map>
 #include <vector>
 
@@ -27,6 +32,10 @@
 
 #include "comm.hpp"
 #include "mpi_variant.hpp"
+#include "rank_gear.hpp"
+#include "rank_list.hpp"
+#include "rank_pair_kernel.hpp"
+#include "rank_walls.hpp"
 #include "rank_particles.hpp"
 #include "rank_stretches.hpp"
 #include "slabs.hpp"
@@ -34,7 +43,6 @@
 #include "demmat/contact_memory.hpp"
 #include "demmat/error.hpp"
 #include "demmat/integrators.hpp"
-#include "demmat/linked_cells.hpp"
 
 namespace demmat::mpi {
 
@@ -70,6 +78,7 @@ public:
             mono_pp_ = pair_coefficients(plan_.r0, plan_.r0, plan_.m0, plan_.m0, params_);
             mono_pw_ = wall_coefficients(plan_.r0, plan_.m0, params_);
         }
+        if constexpr (!law) kernel_.init(params_, mono_pp_);
         // Rank 0 holds the whole state: each rank receives its slab's particles as migrants.
         std::vector<std::vector<double>> parts;
         if (comm_.root()) {
@@ -95,18 +104,17 @@ public:
         migrants_ = 0;
         rebuilds_ = 0;
         built_ = false;
+        corrector_pending_ = false;
     }
 
+    // The pending corrector of the last step fused with this step's predictor, and the displacement
+    // check (rank_gear.hpp).
     void predict(std::int64_t step) override
     {
         step_ = step;
-        for (std::size_t l = 0; l < p_.owned(); ++l) {
-            each_component([&](auto c) {
-                Gear5Scheme::predict(c(p_.x[l]), c(p_.v[l]), c(p_.a[l]), c(p_.b3[l]), c(p_.b4[l]), c(p_.b5[l]), coef_);
-                if constexpr (M::rotation)
-                    Gear5Scheme::predict(c(p_.th[l]), c(p_.w[l]), c(p_.al[l]), c(p_.q3[l]), c(p_.q4[l]), c(p_.q5[l]), coef_);
-            });
-        }
+        const double limit = 0.45 * plan_.skin;
+        moved_far_ = gear_pass<M::rotation>(p_, coef_, corrector_pending_, built_ ? x_built_.data() : nullptr, limit * limit);
+        corrector_pending_ = false;
         if constexpr (M::moving_walls) place_walls(step);
     }
 
@@ -117,9 +125,9 @@ public:
             exchange_ghosts();
             find_pairs();
             if constexpr (M::memory) {  // each new pair takes its stretch by key; the others start at zero
-                st_.pair.assign(pairs_.size(), Stretch<double>{});
-                for (std::size_t k = 0; k < pairs_.size(); ++k) {
-                    const auto it = st_.pending.find({p_.id[std::size_t(pairs_[k].i)], p_.id[std::size_t(pairs_[k].j)]});
+                st_.pair.assign(list_.pairs.size(), Stretch<double>{});
+                for (std::size_t k = 0; k < list_.pairs.size(); ++k) {
+                    const auto it = st_.pending.find({p_.id[std::size_t(list_.pairs[k].i)], p_.id[std::size_t(list_.pairs[k].j)]});
                     if (it != st_.pending.end()) st_.pair[k] = it->second;
                 }
                 st_.pending.clear();
@@ -137,45 +145,64 @@ public:
 
     void forces() override
     {
-        const std::size_t np = pairs_.size();
-        pf_.resize(np);
-        live_.resize(np);
-        pp_ = 0;
         pw_ = 0;
-        candidates_ = 0;
         const std::size_t no = p_.owned();
-        for (std::size_t k = 0; k < np; ++k) {
-            const auto [i, j] = pairs_[k];
-            if constexpr (law) {  // a §9 law: the pair's stretch in and out (none to carry for restitution damping alone)
-                Stretch<double> s{};
-                if constexpr (M::memory) s = st_.pair[k];
-                live_[k] = particle_contact_memory<M>(p_.x[i], p_.x[j], p_.v[i], p_.v[j], p_.w[i], p_.w[j], p_.r[i], p_.r[j], p_.m[i],
-                                                      p_.m[j], params_, memory_, s, true, pf_[k]);
-                if constexpr (M::memory) st_.pair[k] = live_[k] ? s : Stretch<double>{};
-            } else {
-                live_[k] = particle_contact<M>(p_.x[i], p_.x[j], p_.v[i], p_.v[j], p_.w[i], p_.w[j], p_.r[i], p_.r[j], p_.m[i], p_.m[j],
-                                               params_, mono_pp_, pf_[k]);
-            }
-            if (std::size_t(i) < no) {  // counted where the lower id is owned: once over all ranks
-                ++candidates_;
-                if (live_[k]) ++pp_;
-            }
+        if constexpr (law) {
+            law_pairs();
+        } else {
+            pp_ = kernel_.run(p_);
+            candidates_ = std::int64_t(list_.counted);
         }
         for (std::size_t l = 0; l < no; ++l) {
             Vec3d f{}, t{};
-            for (std::size_t e = row_start_[l]; e < row_start_[l + 1]; ++e) {
-                const Entry& en = rows_[e];
-                if (!live_[std::size_t(en.pair)]) continue;  // a pair the law rejects adds nothing, not even a zero
-                const ContactForce<double>& c = pf_[std::size_t(en.pair)];
-                if (en.lower) {
-                    f = f + c.f_i;
-                    if constexpr (M::rotation) t = t + c.t_i;
-                } else {
-                    f = f + (-c.f_i);
-                    if constexpr (M::rotation) t = t + c.t_j;
+            if constexpr (law) {
+                for (std::size_t e = list_.row_start[l]; e < list_.row_start[l + 1]; ++e) {
+                    const Entry& en = list_.rows[e];
+                    if (!live_[std::size_t(en.pair)]) continue;  // a pair the law rejects adds nothing, not even a zero
+                    const ContactForce<double>& c = pf_[std::size_t(en.pair)];
+                    if (en.lower) {
+                        f = f + c.f_i;
+                        if constexpr (M::rotation) t = t + c.t_i;
+                    } else {
+                        f = f + (-c.f_i);
+                        if constexpr (M::rotation) t = t + c.t_j;
+                    }
+                }
+            } else {
+                // Every listed pair's slot, zeros out of contact: they add nothing (a sum that starts
+                // at +0 is never -0, and x + ±0 = x), so the bits are those of skipping the pair.
+                for (std::size_t e = list_.row_start[l]; e < list_.row_start[l + 1]; ++e) {
+                    const Entry& en = list_.rows[e];
+                    const fast::Slot& c = kernel_.slot(std::size_t(en.pair));
+                    if (en.lower) {
+                        f = f + c.f;
+                        if constexpr (M::rotation) t = t + c.ti;
+                    } else {
+                        f = f + (-c.f);
+                        if constexpr (M::rotation) t = t + c.tj;
+                    }
                 }
             }
-            if constexpr (M::walls) {
+            if constexpr (M::walls && !M::memory) {
+                // Without stretches to forget, a wall that is not a candidate adds nothing: the candidates
+                // alone, in wall order.
+                for (std::size_t e = wall_start_[l]; e < wall_start_[l + 1]; ++e) {
+                    const std::size_t w = std::size_t(wall_rows_[e]);
+                    ContactForce<double> c;
+                    Stretch<double> none{};  // restitution damping alone: no stretch to carry
+                    bool live;
+                    if constexpr (law)
+                        live = wall_contact_memory<M>(p_.x[l], p_.v[l], p_.w[l], p_.r[l], p_.m[l], wp_[w], walls_[w].normal, walls_[w].velocity,
+                                                      params_, memory_, none, true, c);
+                    else
+                        live = wall_contact<M>(p_.x[l], p_.v[l], p_.w[l], p_.r[l], p_.m[l], wp_[w], walls_[w].normal, walls_[w].velocity,
+                                               params_, mono_pw_, c);
+                    if (!live) continue;
+                    ++pw_;
+                    f = f + c.f_i;
+                    if constexpr (M::rotation) t = t + c.t_i;
+                }
+            } else if constexpr (M::walls) {
                 std::size_t e = wall_start_[l];
                 for (std::size_t w = 0; w < walls_.size(); ++w) {  // in wall order; the candidates are a sorted subset
                     const bool candidate = e < wall_start_[l + 1] && std::size_t(wall_rows_[e]) == w;
@@ -209,24 +236,17 @@ public:
         }
     }
 
-    void correct() override
-    {
-        for (std::size_t l = 0; l < p_.owned(); ++l) {
-            each_component([&](auto c) {
-                Gear5Scheme::correct(c(p_.x[l]), c(p_.v[l]), c(p_.a[l]), c(p_.b3[l]), c(p_.b4[l]), c(p_.b5[l]), c(p_.acc[l]), coef_);
-                if constexpr (M::rotation)
-                    Gear5Scheme::correct(c(p_.th[l]), c(p_.w[l]), c(p_.al[l]), c(p_.q3[l]), c(p_.q4[l]), c(p_.q5[l]), c(p_.alc[l]), coef_);
-            });
-        }
-    }
+    // Pending until the next predict (its pass applies it) or a snapshot or save (they read `corrected`).
+    void correct() override { corrector_pending_ = true; }
 
     void snapshot(Snapshot& out) const override
     {
+        const RankParticles now = corrected<M::rotation>(p_, coef_, corrector_pending_);
         std::vector<double> mine;
-        mine.reserve(16 * p_.owned());
-        for (std::size_t l = 0; l < p_.owned(); ++l) {
-            mine.push_back(id_to_double(p_.id[l]));
-            for (const Vec3d* q : {&p_.x[l], &p_.v[l], &p_.w[l], &p_.f[l], &p_.t[l]})
+        mine.reserve(16 * now.owned());
+        for (std::size_t l = 0; l < now.owned(); ++l) {
+            mine.push_back(id_to_double(now.id[l]));
+            for (const Vec3d* q : {&now.x[l], &now.v[l], &now.w[l], &now.f[l], &now.t[l]})
                 for (int c = 0; c < 3; ++c) mine.push_back(component(*q, c));
         }
         const std::vector<double> all = comm_.gather(mine);
@@ -245,9 +265,10 @@ public:
 
     void save(State& out) const override
     {
+        const RankParticles now = corrected<M::rotation>(p_, coef_, corrector_pending_);
         std::vector<double> mine;
-        mine.reserve(kMigrantDoubles * p_.owned());
-        for (std::size_t l = 0; l < p_.owned(); ++l) p_.pack_migrant(l, mine);
+        mine.reserve(kMigrantDoubles * now.owned());
+        for (std::size_t l = 0; l < now.owned(); ++l) now.pack_migrant(l, mine);
         const std::vector<double> all = comm_.gather(mine);
         out = State{};
         out.step = step_;
@@ -272,9 +293,9 @@ public:
     ContactCounts counts() const override { return {comm_.sum(pp_), comm_.sum(pw_), comm_.sum(candidates_)}; }
     std::size_t memory_bytes() const override
     {
-        return p_.memory_bytes() + st_.memory_bytes() + pairs_.capacity() * sizeof(Pair) + rows_.capacity() * sizeof(Entry) +
-               (row_start_.capacity() + wall_start_.capacity()) * sizeof(std::size_t) + wall_rows_.capacity() * sizeof(std::int32_t) +
-               pf_.capacity() * sizeof(ContactForce<double>) + live_.capacity() + cells_.memory_bytes();
+        return p_.memory_bytes() + st_.memory_bytes() + list_.memory_bytes() + wall_start_.capacity() * sizeof(std::size_t) +
+               wall_rows_.capacity() * sizeof(std::int32_t) + near_.capacity() * sizeof(std::uint64_t) + pf_.capacity() * sizeof(ContactForce<double>) +
+               live_.capacity() + kernel_.memory_bytes();
     }
     ModelFeatures model() const override { return ModelFeatures::of<M>(); }
 
@@ -289,22 +310,29 @@ public:
     }
 
 private:
-    struct Pair {
-        std::int32_t i, j;  // local indices, id[i] < id[j]
-    };
-    struct Entry {
-        std::int64_t partner;  // the partner's id: the key of the canonical order
-        std::int32_t pair;
-        bool lower;            // this particle is the pair's i (the lower id)
-    };
+    using Pair = RankList::Pair;
+    using Entry = RankList::Entry;
 
-    // f(c) for the three components, c(v) being v.x, v.y or v.z (no run-time branch per value).
-    template <class F>
-    static void each_component(F&& f)
+    // A law of physics.md §9: each listed pair through the scalar law, its stretch in and out.
+    void law_pairs()
     {
-        f([](auto& v) -> auto& { return v.x; });
-        f([](auto& v) -> auto& { return v.y; });
-        f([](auto& v) -> auto& { return v.z; });
+        const std::size_t np = list_.pairs.size(), no = p_.owned();
+        pf_.resize(np);
+        live_.resize(np);
+        pp_ = 0;
+        candidates_ = 0;
+        for (std::size_t k = 0; k < np; ++k) {
+            const auto [i, j] = list_.pairs[k];
+            Stretch<double> s{};  // none to carry for restitution damping alone
+            if constexpr (M::memory) s = st_.pair[k];
+            live_[k] = particle_contact_memory<M>(p_.x[i], p_.x[j], p_.v[i], p_.v[j], p_.w[i], p_.w[j], p_.r[i], p_.r[j], p_.m[i], p_.m[j],
+                                                  params_, memory_, s, true, pf_[k]);
+            if constexpr (M::memory) st_.pair[k] = live_[k] ? s : Stretch<double>{};
+            if (std::size_t(i) < no) {  // counted where the lower id is owned: once over all ranks
+                ++candidates_;
+                if (live_[k]) ++pp_;
+            }
+        }
     }
 
     void place_walls(std::int64_t step)
@@ -330,16 +358,16 @@ private:
         if constexpr (M::memory) {
             // Every live pair's stretch by its key, while the ghosts' ids are still here; a migrant's pairs
             // go with it (the rank it joins may not hold the partner).
-            for (std::size_t k = 0; k < pairs_.size() && k < live_.size(); ++k)
-                if (live_[k]) st_.pending[{p_.id[std::size_t(pairs_[k].i)], p_.id[std::size_t(pairs_[k].j)]}] = st_.pair[k];
+            for (std::size_t k = 0; k < list_.pairs.size() && k < live_.size(); ++k)
+                if (live_[k]) st_.pending[{p_.id[std::size_t(list_.pairs[k].i)], p_.id[std::size_t(list_.pairs[k].j)]}] = st_.pair[k];
             for (std::size_t l = 0; l < p_.owned(); ++l) {
                 const int to = plan_.slabs.owner(axis_coordinate(l));
-                if (to == me || row_start_.size() <= l + 1) continue;
-                for (std::size_t e = row_start_[l]; e < row_start_[l + 1]; ++e) {
-                    const std::size_t k = std::size_t(rows_[e].pair);
+                if (to == me || list_.row_start.size() <= l + 1) continue;
+                for (std::size_t e = list_.row_start[l]; e < list_.row_start[l + 1]; ++e) {
+                    const std::size_t k = std::size_t(list_.rows[e].pair);
                     if (k < live_.size() && live_[k])
-                        pack_stretch(to < me ? down_stretches : up_stretches, p_.id[std::size_t(pairs_[k].i)],
-                                     p_.id[std::size_t(pairs_[k].j)], st_.pair[k]);
+                        pack_stretch(to < me ? down_stretches : up_stretches, p_.id[std::size_t(list_.pairs[k].i)],
+                                     p_.id[std::size_t(list_.pairs[k].j)], st_.pair[k]);
                 }
             }
         }
@@ -425,9 +453,9 @@ private:
     {
         std::vector<double> mine;
         const std::size_t no = p_.owned();
-        for (std::size_t k = 0; k < pairs_.size() && k < live_.size(); ++k)
-            if (live_[k] && std::size_t(pairs_[k].i) < no)
-                pack_stretch(mine, p_.id[std::size_t(pairs_[k].i)], p_.id[std::size_t(pairs_[k].j)], st_.pair[k]);
+        for (std::size_t k = 0; k < list_.pairs.size() && k < live_.size(); ++k)
+            if (live_[k] && std::size_t(list_.pairs[k].i) < no)
+                pack_stretch(mine, p_.id[std::size_t(list_.pairs[k].i)], p_.id[std::size_t(list_.pairs[k].j)], st_.pair[k]);
         for (std::size_t l = 0; l < no; ++l)
             for (std::size_t w = 0; w < walls_.size(); ++w)
                 if (st_.wall_live[l * walls_.size() + w]) pack_stretch(mine, p_.id[l], -1 - std::int64_t(w), st_.wall[l * walls_.size() + w]);
@@ -495,74 +523,18 @@ private:
     }
 
     // Has any particle on any rank moved more than 0.45 skin since the last rebuild (fast's criterion)?
-    bool must_rebuild()
-    {
-        double worst = 0.0;
-        for (std::size_t l = 0; l < p_.owned(); ++l) {
-            const Vec3d d = p_.x[l] - x_built_[l];
-            worst = std::max(worst, dot(d, d));
-        }
-        const double limit = 0.45 * plan_.skin;
-        // A NaN position compares false: rebuild, so that the cell search names the particle.
-        return comm_.any(!(worst <= limit * limit));
-    }
+    // Each rank's answer comes from its predict pass.
+    bool must_rebuild() { return comm_.any(moved_far_); }
 
-    // Every pair with an owned particle that may_touch accepts (owned first in the local order: a pair
-    // (a, b), a < b, has an owned particle exactly when a is owned), and each owned particle's row of
-    // partners sorted by id.
+    // The rank's neighbour list (rank_list.hpp), and under the paper's law the kernel's slots.
     void find_pairs()
     {
-        const std::size_t n = p_.size(), no = p_.owned();
-        px_.resize(n);
-        py_.resize(n);
-        pz_.resize(n);
-        for (std::size_t l = 0; l < n; ++l) {
-            px_[l] = p_.x[l].x;
-            py_[l] = p_.x[l].y;
-            pz_[l] = p_.x[l].z;
-        }
-        if (n > cells_reserved_) {
-            cells_reserved_ = n + n / 4;
-            cells_.reserve(cells_reserved_);
-        }
-        pairs_.clear();
-        const double half_skin = 0.5 * plan_.skin;  // may_touch with each radius grown: pairs closer than R_i + R_j + skin
-        if (n > 0) cells_.build(n, px_.data(), py_.data(), pz_.data(), plan_.cell);
-        for (std::size_t a = 0; a < no; ++a)
-            cells_.for_each_above(a, [&](std::size_t b) {
-                if (!may_touch(p_.x[a], p_.x[b], p_.r[a] + half_skin, p_.r[b] + half_skin)) return;
-                pairs_.push_back(p_.id[a] < p_.id[b] ? Pair{std::int32_t(a), std::int32_t(b)} : Pair{std::int32_t(b), std::int32_t(a)});
-            });
-        row_start_.assign(no + 1, 0);
-        for (const Pair& q : pairs_) {
-            if (std::size_t(q.i) < no) ++row_start_[std::size_t(q.i) + 1];
-            if (std::size_t(q.j) < no) ++row_start_[std::size_t(q.j) + 1];
-        }
-        for (std::size_t l = 0; l < no; ++l) row_start_[l + 1] += row_start_[l];
-        rows_.resize(row_start_[no]);
-        fill_.assign(row_start_.begin(), row_start_.end() - 1);
-        for (std::size_t k = 0; k < pairs_.size(); ++k) {
-            const Pair& q = pairs_[k];
-            if (std::size_t(q.i) < no) rows_[fill_[std::size_t(q.i)]++] = {p_.id[std::size_t(q.j)], std::int32_t(k), true};
-            if (std::size_t(q.j) < no) rows_[fill_[std::size_t(q.j)]++] = {p_.id[std::size_t(q.i)], std::int32_t(k), false};
-        }
-        for (std::size_t l = 0; l < no; ++l)  // a few partners per row: insertion sort
-            for (std::size_t e = row_start_[l] + 1; e < row_start_[l + 1]; ++e)
-                for (std::size_t k = e; k > row_start_[l] && rows_[k - 1].partner > rows_[k].partner; --k) std::swap(rows_[k - 1], rows_[k]);
+        list_.build(p_, plan_.cell, plan_.skin);
+        if constexpr (!law) kernel_.set_pairs(list_.pairs, list_.counted);
     }
 
     // The walls each owned particle may touch, in wall order.
-    void find_walls()
-    {
-        const std::size_t no = p_.owned();
-        wall_start_.assign(no + 1, 0);
-        wall_rows_.clear();
-        for (std::size_t l = 0; l < no; ++l) {
-            for (std::size_t w = 0; w < walls_.size(); ++w)
-                if (may_touch_wall(p_.x[l], p_.r[l], wp_[w], walls_[w].normal)) wall_rows_.push_back(std::int32_t(w));
-            wall_start_[l + 1] = wall_rows_.size();
-        }
-    }
+    void find_walls() { list_wall_candidates(p_, walls_, wp_, wall_start_, wall_rows_, near_); }
 
     static constexpr bool law = M::restitution_damping || M::history || M::rolling;  // a §9 law, not the paper's
 
@@ -572,6 +544,8 @@ private:
     RankStretches st_;  // a §9 law with memory: the stretches
     std::int64_t step_ = 0, steps_ = 0, owned_max_ = 0, migrants_ = 0, rebuilds_ = 0;
     bool built_ = false;
+    bool corrector_pending_ = false;  // correct() was called; the next predict applies it
+    bool moved_far_ = false;          // the last predict moved some owned particle 0.45 skin from x_built_
     std::vector<Vec3d> x_built_;                         // owned positions at the last rebuild
     std::vector<std::int32_t> send_down_, send_up_;      // the owned particles whose ghosts the neighbours hold
     std::size_t ghosts_from_down_ = 0, ghosts_from_up_ = 0;
@@ -584,16 +558,19 @@ private:
     std::vector<Vec3d> wp_;  // the walls' points at the current step
     RankParticles p_;
     std::vector<double> down_, up_, from_down_, from_up_;  // exchange buffers, kept between steps
-    std::vector<double> px_, py_, pz_;
-    LinkedCells cells_;
-    std::size_t cells_reserved_ = 0;
-    std::vector<Pair> pairs_;
-    std::vector<Entry> rows_;
-    std::vector<std::size_t> row_start_, fill_, wall_start_;
+    RankList list_;
+    std::vector<std::size_t> wall_start_;
     std::vector<std::int32_t> wall_rows_;
+    std::vector<std::uint64_t> near_;  // find_walls: a bit per wall that each owned particle may touch
     std::vector<ContactForce<double>> pf_;
     std::vector<char> live_;
     std::int64_t pp_ = 0, pw_ = 0, candidates_ = 0;
+    RankPairKernel<M> kernel_;        // the paper's law: the pairs on lanes
 };
+
+// The instantiations, in two translation units compiled side by side: the paper's law on with_model's
+// models (rank_paper.cpp) and the laws of physics.md §9 on the full model (rank_laws.cpp).
+std::unique_ptr<MpiVariant> make_rank_processor_paper(const ModelFeatures& need, const Comm& comm, const Plan& plan);
+std::unique_ptr<MpiVariant> make_rank_processor_law(const ModelFeatures& need, const Comm& comm, const Plan& plan);
 
 } // namespace demmat::mpi
