@@ -88,8 +88,11 @@ public:
                     auto inside = [&](Index s) {
                         return down ? std::size_t(last_chunk[s]) < c1 : std::size_t(first_chunk[s]) >= c0;
                     };
-                    bool all = true;
-                    for (int l = 0; l < g.count; ++l) all = all && inside(g.grain[l]);
+                    bool all = pieces == 1;  // one piece (one or two threads): every sum is inside
+                    if (!all) {
+                        all = true;
+                        for (int l = 0; l < g.count; ++l) all = all && inside(g.grain[l]);
+                    }
                     if (all) {
                         sums.sum_group(g, in_ring.ring, walls, p);
                         continue;

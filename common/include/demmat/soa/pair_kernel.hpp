@@ -32,10 +32,30 @@ struct SlotSink {
     Slot* ring = nullptr;
     std::size_t mask = 0;
     Slot* all = nullptr;
-    [[gnu::always_inline]] void put(std::size_t k, const Slot& v) const
+    // count slots ks[e]'s nine values: the first eight as two quads, the ninth alone, straight from the
+    // kernel's rows into place. A whole pack (count = kLanes) is a loop of known length, which the
+    // compiler unrolls, and the test for `all` is made once per call, not once per slot.
+    template <class Head, class Tail, class Last>
+    [[gnu::always_inline]] void put(const std::size_t* ks, int count, Head&& head, Tail&& tail, Last&& last) const
     {
-        ring[k & mask] = v;
-        if (all) all[k] = v;
+        auto to = [&](Slot* base, std::size_t m) {
+            auto one = [&](int e) { write(base + (ks[e] & m), head(e), tail(e), last(e)); };
+            if (count == kLanes)
+                for (int e = 0; e < kLanes; ++e) one(e);
+            else
+                for (int e = 0; e < count; ++e) one(e);
+        };
+        to(ring, mask);
+        if (all) to(all, ~std::size_t(0));
+    }
+
+private:
+    [[gnu::always_inline]] static void write(Slot* at, const Quad& head, const Quad& tail, double last)
+    {
+        char* bytes = reinterpret_cast<char*>(at);
+        std::memcpy(bytes, &head, sizeof(Quad));
+        std::memcpy(bytes + sizeof(Quad), &tail, sizeof(Quad));
+        at->tj.z = last;
     }
 };
 
@@ -108,7 +128,11 @@ public:
                 nd += std::size_t(!t);
             }
             if constexpr (Canonical)
-                for (std::size_t e = 0; e < nd; ++e) sink.put(dropped[e], Slot{});
+                for (std::size_t e = 0; e < nd; e += kLanes) {
+                    const Quad zero{};
+                    auto zeros = [&](int) -> const Quad& { return zero; };
+                    sink.put(dropped + e, int(std::min<std::size_t>(kLanes, nd - e)), zeros, zeros, [](int) { return 0.0; });
+                }
             if constexpr (kQ > 0)  // out of contact: the stretch is forgotten
                 for (std::size_t e = 0; e < nd; ++e)
                     for (std::size_t q = 0; q < kQ; ++q) stretch_[dropped[e] * kQ + q] = Quad{};
@@ -158,21 +182,18 @@ private:
             }
         }();
         int found = 0;
-        for (int l = 0; l < count; ++l) found += int(touch[l] != 0);
+        if (count == kLanes)  // a loop of known length, unrolled
+            for (int l = 0; l < kLanes; ++l) found += int(touch[l] != 0);
+        else
+            for (int l = 0; l < count; ++l) found += int(touch[l] != 0);
         if constexpr (Canonical) {
             // A slot is nine values: f, t_i, t_j; the first eight go as two quads, the ninth alone.
             const Lanes g0[4] = {c.f_i.x, c.f_i.y, c.f_i.z, c.t_i.x}, g1[4] = {c.t_i.y, c.t_i.z, c.t_j.x, c.t_j.y};
             Quad r0[kLanes], r1[kLanes];
             lanes_to_rows<Lanes>(g0, r0);
             lanes_to_rows<Lanes>(g1, r1);
-            for (int l = 0; l < count; ++l) {
-                Slot out;
-                char* bytes = reinterpret_cast<char*>(&out);
-                std::memcpy(bytes, &r0[l], sizeof(Quad));
-                std::memcpy(bytes + sizeof(Quad), &r1[l], sizeof(Quad));
-                out.tj.z = c.t_j.z[l];
-                sink.put(k[l], out);
-            }
+            sink.put(k, count, [&](int l) -> const Quad& { return r0[l]; }, [&](int l) -> const Quad& { return r1[l]; },
+                     [&](int l) { return c.t_j.z[l]; });
         } else {
             // Added as they come, lane by lane (a particle may sit in several lanes).
             const Lanes zero{};

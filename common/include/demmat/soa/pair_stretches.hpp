@@ -52,7 +52,10 @@ template <class M, class Mask>
         const Lanes g[4] = {kept.x, kept.y, kept.z, Lanes{}};
         Quad rows[kLanes];
         lanes_to_rows<Lanes>(g, rows);
-        for (int l = 0; l < count; ++l) base[k[l] * Q + q] = rows[l];
+        if (count == kLanes)  // a whole pack: a loop of known length, unrolled
+            for (int l = 0; l < kLanes; ++l) base[k[l] * Q + q] = rows[l];
+        else
+            for (int l = 0; l < count; ++l) base[k[l] * Q + q] = rows[l];
     };
     if constexpr (M::history) put(st.t, 0);
     if constexpr (M::rolling) put(st.r, Q - 1);

@@ -87,7 +87,11 @@ public:
     // chunk's positions are read once), then its pairs in particle order, walls in wall order. Beyond
     // kWallBits walls one bit stands for any, and each wall is tested again for the particles marked.
     // With a law with memory, old_slot(s) is particle s's slot in the listing before.
-    void clear_list(std::size_t t) { now_->cand[t].clear(); }
+    void clear_list(std::size_t t)
+    {
+        now_->cand[t].clear();
+        now_->st[t].clear();
+    }
     void list(const Particles& p, std::size_t lo, std::size_t hi, std::size_t t) { list(p, lo, hi, t, [](std::size_t s) { return s; }); }
     template <class OldSlot>
     void list(const Particles& p, std::size_t lo, std::size_t hi, std::size_t t, OldSlot&& old_slot)
@@ -95,6 +99,7 @@ public:
         Listing& l = *now_;
         mark(p, lo, hi);
         std::vector<Candidate>& cand = l.cand[t];
+        const std::size_t before = cand.size();  // a thread lists its range a block at a time
         const std::uint8_t* near = l.near.data();
         const std::size_t nw = walls_.size();
         for (std::size_t s = lo; s < hi; ++s) {
@@ -110,8 +115,8 @@ public:
         }
         if (q_ == 0) return;
         std::vector<Quad>& st = l.st[t];
-        st.assign(cand.size() * q_, Quad{});
-        for (std::size_t e = 0; e < cand.size(); ++e) carry(old_slot(std::size_t(cand[e].s)), std::size_t(cand[e].w), st.data() + e * q_);
+        st.resize(cand.size() * q_, Quad{});
+        for (std::size_t e = before; e < cand.size(); ++e) carry(old_slot(std::size_t(cand[e].s)), std::size_t(cand[e].w), st.data() + e * q_);
     }
     void size_results(std::size_t t) { now_->res[t].resize(now_->cand[t].size()); }
 
