@@ -3,9 +3,11 @@
 // runs), for the paper's law. The rank's particles, owned and ghosts, get the kernel's records (one
 // record of three quads per particle, soa/particles.hpp); its listed pairs (lower id as i) become the
 // kernel's slots, each contact's force and torques into its slot, zeros where the pair is out of
-// contact; the rank's canonical gather then reads the slots (rank_processor.hpp). The slots are ordered
-// with the pairs whose lower id this rank owns first, so that the contacts are counted once over all
-// ranks. Each lane has the scalar law's bits, so the slots hold what particle_contact gives.
+// contact; the rank's canonical gather then reads the slots (rank_processor.hpp), a block of particles
+// at a time (the list's order, rank_list.hpp), from a ring that stays in cache, as fast's sweep does. Each lane has the scalar law's bits, so the slots hold what
+// particle_contact gives.
+#include <algorithm>
+#include <bit>
 #include <cstdint>
 #include <vector>
 
@@ -34,36 +36,20 @@ public:
         law_.mono_pp = {splat<fast::Lanes>(mono_pp.kn), splat<fast::Lanes>(mono_pp.cn), splat<fast::Lanes>(mono_pp.ct)};
     }
 
-    // At a rebuild: the pairs (local indices, i the lower id), those with i owned first (`counted` of them).
+    // At a rebuild: the pairs (local indices, i the lower id), the `counted` ones (i owned) first, in
+    // the order of the list (rank_list.hpp); the sums read a counted slot at most `reach` slots after
+    // it was written, so a ring of that many keeps them. The pairs whose i is a ghost keep a slot each.
     template <class Pair>
-    void set_pairs(const std::vector<Pair>& pairs, std::size_t counted)
+    void set_pairs(const std::vector<Pair>& pairs, std::size_t counted, std::size_t reach)
     {
-        list_.owner.resize(pairs.size());
-        list_.partner.resize(pairs.size());
-        for (std::size_t k = 0; k < pairs.size(); ++k) {
-            list_.owner[k] = fast::Index(pairs[k].i);
-            list_.partner[k] = fast::Index(pairs[k].j);
-        }
         counted_ = counted;
-        slots_.resize(pairs.size());
+        fill(list_, pairs, 0, counted);
+        fill(ghost_list_, pairs, counted, pairs.size());
+        ring_.resize(std::bit_ceil(std::max<std::size_t>(reach, 1)));
+        ghost_slots_.resize(pairs.size() - counted);
     }
 
-    // Every slot from the particles' current state; returns the contacts among the counted pairs.
-    std::int64_t run(const RankParticles& p)
-    {
-        refresh_records(p);
-        const fast::PairKernel<PairModel<M>> kernel(list_, soa_, law_, nullptr, p.size() >= kPrefetchFrom);
-        const fast::SlotSink sink{slots_.data(), ~std::size_t(0), nullptr};
-        const std::int64_t found = kernel.template run<true>(0, counted_, nullptr, sink);
-        kernel.template run<true>(counted_, slots_.size(), nullptr, sink);
-        return found;
-    }
-
-    const fast::Slot& slot(std::size_t k) const { return slots_[k]; }
-
-    std::size_t memory_bytes() const { return list_.bytes() + soa_.bytes() + fast::heap_bytes(slots_); }
-
-private:
+    // The kernel's records from the particles' current state: before run, once per force pass.
     void refresh_records(const RankParticles& p)
     {
         const std::size_t n = p.size();
@@ -74,13 +60,48 @@ private:
             rec[l].v = fast::Quad{p.v[l].x, p.v[l].y, p.v[l].z, p.m[l]};
             rec[l].w = fast::Quad{p.w[l].x, p.w[l].y, p.w[l].z, 0.0};
         }
+        prefetch_ = n >= kPrefetchFrom;
+    }
+
+    // The pairs whose i is a ghost: few, at the faces, each into its own slot. First in a force pass.
+    void run_ghost_pairs()
+    {
+        if (ghost_list_.pairs() == 0) return;
+        const fast::PairKernel<PairModel<M>> kernel(ghost_list_, soa_, law_, nullptr, false);  // too few to prefetch
+        kernel.template run<true>(0, ghost_list_.pairs(), nullptr, fast::SlotSink{ghost_slots_.data(), ~std::size_t(0), nullptr});
+    }
+
+    // Counted slots [begin, end), into the ring; returns the contacts among them.
+    std::int64_t run(std::size_t begin, std::size_t end)
+    {
+        if (begin >= end) return 0;
+        const fast::PairKernel<PairModel<M>> kernel(list_, soa_, law_, nullptr, prefetch_ && list_.pairs() >= fast::kLanes);
+        return kernel.template run<true>(begin, end, nullptr, fast::SlotSink{ring_.data(), ring_.size() - 1, nullptr});
+    }
+
+    // Pair k's slot: valid from the run that wrote it until the ring comes round.
+    const fast::Slot& slot(std::size_t k) const { return k < counted_ ? ring_[k & (ring_.size() - 1)] : ghost_slots_[k - counted_]; }
+
+    std::size_t memory_bytes() const { return list_.bytes() + ghost_list_.bytes() + soa_.bytes() + fast::heap_bytes(ring_, ghost_slots_); }
+
+private:
+    template <class Pair>
+    static void fill(fast::NeighbourList& list, const std::vector<Pair>& pairs, std::size_t begin, std::size_t end)
+    {
+        list.owner.resize(end - begin);
+        list.partner.resize(end - begin);
+        for (std::size_t k = begin; k < end; ++k) {
+            list.owner[k - begin] = fast::Index(pairs[k].i);
+            list.partner[k - begin] = fast::Index(pairs[k].j);
+        }
     }
 
     fast::LawInputs law_;
     fast::Particles soa_;         // only the kernel's records (kin) are used
-    fast::NeighbourList list_;    // only the slots' owners and partners are used
-    std::vector<fast::Slot> slots_;
+    fast::NeighbourList list_, ghost_list_;  // the counted pairs, the others; only owners and partners are used
+    std::vector<fast::Slot> ring_, ghost_slots_;
     std::size_t counted_ = 0;
+    bool prefetch_ = false;
 };
 
 } // namespace demmat::mpi

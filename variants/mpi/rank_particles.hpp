@@ -79,6 +79,23 @@ struct RankParticles {
         resize_owned(last);
     }
 
+    // Puts the owned particles in a new order: slot s takes the particle from slot from[s] (ghosts must
+    // have been dropped). The rank sorts them into cell order at each rebuild, so that a particle's
+    // partners, their records and their slots lie near it in memory.
+    void permute_owned(const std::vector<std::size_t>& from)
+    {
+        auto apply = [&](auto& v) {
+            auto old = v;  // a copy per array: a rebuild is rare beside the steps between
+            for (std::size_t s = 0; s < n_owned; ++s) v[s] = old[from[s]];
+        };
+        apply(id);
+        apply(r);
+        apply(m);
+        apply(inertia);
+        for (std::vector<Vec3d>* g : gear()) apply(*g);
+        for (auto* g : {&f, &t, &acc, &alc}) apply(*g);
+    }
+
     void pack_ghost(std::size_t l, std::vector<double>& out) const
     {
         out.push_back(id_to_double(id[l]));

@@ -43,6 +43,7 @@
 #include "demmat/contact_memory.hpp"
 #include "demmat/error.hpp"
 #include "demmat/integrators.hpp"
+#include "demmat/soa/cell_order.hpp"
 
 namespace demmat::mpi {
 
@@ -122,6 +123,7 @@ public:
     {
         if (!built_ || must_rebuild()) {
             migrate();
+            sort_owned();
             exchange_ghosts();
             find_pairs();
             if constexpr (M::memory) {  // each new pair takes its stretch by key; the others start at zero
@@ -149,38 +151,54 @@ public:
         const std::size_t no = p_.owned();
         if constexpr (law) {
             law_pairs();
+            sum_owned(0, no);
         } else {
-            pp_ = kernel_.run(p_);
+            // The pairs whose lower id is a ghost's first (few, at the faces), then block by block the
+            // pairs found at a block's particles and the block's sums, while its slots are in cache.
+            kernel_.refresh_records(p_);
+            kernel_.run_ghost_pairs();
+            pp_ = 0;
+            for (std::size_t a = 0; a < no; a += kSumBlock) {
+                const std::size_t b = std::min(no, a + kSumBlock);
+                pp_ += kernel_.run(list_.found_at[a], list_.found_at[b]);
+                sum_owned(a, b);
+            }
             candidates_ = std::int64_t(list_.counted);
         }
-        for (std::size_t l = 0; l < no; ++l) {
+    }
+
+    // Owned particles [a, b): each one's sum in the canonical order (its pairs as j, as i, then its
+    // walls), its loads and accelerations.
+    void sum_owned(std::size_t a, std::size_t b)
+    {
+        for (std::size_t l = a; l < b; ++l) {
             Vec3d f{}, t{};
+            const std::int32_t* rows = list_.rows.data();
             if constexpr (law) {
-                for (std::size_t e = list_.row_start[l]; e < list_.row_start[l + 1]; ++e) {
-                    const Entry& en = list_.rows[e];
-                    if (!live_[std::size_t(en.pair)]) continue;  // a pair the law rejects adds nothing, not even a zero
-                    const ContactForce<double>& c = pf_[std::size_t(en.pair)];
-                    if (en.lower) {
-                        f = f + c.f_i;
-                        if constexpr (M::rotation) t = t + c.t_i;
-                    } else {
-                        f = f + (-c.f_i);
-                        if constexpr (M::rotation) t = t + c.t_j;
-                    }
+                for (std::size_t e = list_.row_start[l]; e < list_.row_mid[l]; ++e) {
+                    const std::size_t k = std::size_t(rows[e]);
+                    if (!live_[k]) continue;  // a pair the law rejects adds nothing, not even a zero
+                    f = f + (-pf_[k].f_i);
+                    if constexpr (M::rotation) t = t + pf_[k].t_j;
+                }
+                for (std::size_t e = list_.row_mid[l]; e < list_.row_start[l + 1]; ++e) {
+                    const std::size_t k = std::size_t(rows[e]);
+                    if (!live_[k]) continue;
+                    f = f + pf_[k].f_i;
+                    if constexpr (M::rotation) t = t + pf_[k].t_i;
                 }
             } else {
                 // Every listed pair's slot, zeros out of contact: they add nothing (a sum that starts
                 // at +0 is never -0, and x + ±0 = x), so the bits are those of skipping the pair.
-                for (std::size_t e = list_.row_start[l]; e < list_.row_start[l + 1]; ++e) {
-                    const Entry& en = list_.rows[e];
-                    const fast::Slot& c = kernel_.slot(std::size_t(en.pair));
-                    if (en.lower) {
-                        f = f + c.f;
-                        if constexpr (M::rotation) t = t + c.ti;
-                    } else {
-                        f = f + (-c.f);
-                        if constexpr (M::rotation) t = t + c.tj;
-                    }
+                for (std::size_t e = list_.row_start[l]; e < list_.row_mid[l]; ++e) {
+                    const fast::Slot& c = kernel_.slot(std::size_t(rows[e]));
+                    f = f + (-c.f);
+                    if constexpr (M::rotation) t = t + c.tj;
+                }
+                for (std::size_t e = list_.row_mid[l]; e < list_.row_start[l + 1]; ++e) {
+                    const fast::Slot& c = kernel_.slot(std::size_t(rows[e]));
+                    f = f + c.f;
+                    if constexpr (M::rotation) t = t + c.ti;
                 }
             }
             if constexpr (M::walls && !M::memory) {
@@ -295,7 +313,7 @@ public:
     {
         return p_.memory_bytes() + st_.memory_bytes() + list_.memory_bytes() + wall_start_.capacity() * sizeof(std::size_t) +
                wall_rows_.capacity() * sizeof(std::int32_t) + near_.capacity() * sizeof(std::uint64_t) + pf_.capacity() * sizeof(ContactForce<double>) +
-               live_.capacity() + kernel_.memory_bytes();
+               live_.capacity() + kernel_.memory_bytes() + order_.bytes() + fast::heap_bytes(order_x_, order_id_, order_from_);
     }
     ModelFeatures model() const override { return ModelFeatures::of<M>(); }
 
@@ -311,7 +329,7 @@ public:
 
 private:
     using Pair = RankList::Pair;
-    using Entry = RankList::Entry;
+    static constexpr std::size_t kSumBlock = 256;  // owned particles per block of forces()
 
     // A law of physics.md §9: each listed pair through the scalar law, its stretch in and out.
     void law_pairs()
@@ -364,7 +382,7 @@ private:
                 const int to = plan_.slabs.owner(axis_coordinate(l));
                 if (to == me || list_.row_start.size() <= l + 1) continue;
                 for (std::size_t e = list_.row_start[l]; e < list_.row_start[l + 1]; ++e) {
-                    const std::size_t k = std::size_t(list_.rows[e].pair);
+                    const std::size_t k = std::size_t(list_.rows[e]);
                     if (k < live_.size() && live_[k])
                         pack_stretch(to < me ? down_stretches : up_stretches, p_.id[std::size_t(list_.pairs[k].i)],
                                      p_.id[std::size_t(list_.pairs[k].j)], st_.pair[k]);
@@ -469,6 +487,26 @@ private:
         std::sort(out.stretches.begin(), out.stretches.end());
     }
 
+    // The owned particles into fast's cell order (soa/cell_order.hpp), so that the list's pairs, the
+    // kernel's records and the slots each sum reads lie near one another in memory. The local order
+    // changes no bits: every sum is in the order of ids.
+    void sort_owned()
+    {
+        const std::size_t no = p_.owned();
+        if (no == 0) return;
+        order_x_.resize(3 * no);
+        order_id_.resize(no);
+        for (std::size_t l = 0; l < no; ++l) {
+            for (int c = 0; c < 3; ++c) order_x_[std::size_t(c) * no + l] = component(p_.x[l], c);
+            order_id_[l] = fast::Index(p_.id[l]);
+        }
+        order_.sort(order_x_, order_id_, no, plan_.cell);
+        order_from_.resize(no);
+        for (std::size_t s = 0; s < no; ++s) order_from_[s] = std::size_t(order_.key(s).from);
+        p_.permute_owned(order_from_);
+        if constexpr (M::memory) st_.permute_owned(order_from_);
+    }
+
     // Copies of the owned particles within the halo of a shared face, for the neighbour across it.
     void exchange_ghosts()
     {
@@ -529,8 +567,8 @@ private:
     // The rank's neighbour list (rank_list.hpp), and under the paper's law the kernel's slots.
     void find_pairs()
     {
-        list_.build(p_, plan_.cell, plan_.skin);
-        if constexpr (!law) kernel_.set_pairs(list_.pairs, list_.counted);
+        list_.build(p_, plan_.cell, plan_.skin, kSumBlock);
+        if constexpr (!law) kernel_.set_pairs(list_.pairs, list_.counted, list_.reach);
     }
 
     // The walls each owned particle may touch, in wall order.
@@ -566,6 +604,10 @@ private:
     std::vector<char> live_;
     std::int64_t pp_ = 0, pw_ = 0, candidates_ = 0;
     RankPairKernel<M> kernel_;        // the paper's law: the pairs on lanes
+    fast::CellOrder order_;           // sort_owned's scratch
+    std::vector<double> order_x_;
+    std::vector<fast::Index> order_id_;
+    std::vector<std::size_t> order_from_;
 };
 
 // The instantiations, in two translation units compiled side by side: the paper's law on with_model's

@@ -58,6 +58,17 @@ struct RankStretches {
             wall_live[l * walls + w] = wall_live[last * walls + w];
         }
     }
+    // The owned particles took a new order (RankParticles::permute_owned): slot s's row is slot from[s]'s.
+    void permute_owned(const std::vector<std::size_t>& from)
+    {
+        const std::vector<Stretch<double>> old = wall;
+        const std::vector<char> old_live = wall_live;
+        for (std::size_t s = 0; s < from.size(); ++s)
+            for (std::size_t w = 0; w < walls; ++w) {
+                wall[s * walls + w] = old[from[s] * walls + w];
+                wall_live[s * walls + w] = old_live[from[s] * walls + w];
+            }
+    }
     void pack_wall_row(std::size_t l, std::vector<double>& out) const
     {
         for (std::size_t w = 0; w < walls; ++w) {
