@@ -45,8 +45,8 @@ public:
         counted_ = counted;
         fill(list_, pairs, 0, counted);
         fill(ghost_list_, pairs, counted, pairs.size());
-        ring_.resize(std::bit_ceil(std::max<std::size_t>(reach, 1)));
-        ghost_slots_.resize(pairs.size() - counted);
+        ring_size_ = std::bit_ceil(std::max<std::size_t>(reach, 1));
+        slots_.assign(ring_size_ + (pairs.size() - counted) + 1, fast::Slot{});  // the ring, the ghosts' pairs, a zero
     }
 
     // The kernel's records from the particles' current state: before run, once per force pass.
@@ -68,7 +68,7 @@ public:
     {
         if (ghost_list_.pairs() == 0) return;
         const fast::PairKernel<PairModel<M>> kernel(ghost_list_, soa_, law_, nullptr, false);  // too few to prefetch
-        kernel.template run<true>(0, ghost_list_.pairs(), nullptr, fast::SlotSink{ghost_slots_.data(), ~std::size_t(0), nullptr});
+        kernel.template run<true>(0, ghost_list_.pairs(), nullptr, fast::SlotSink{slots_.data() + ring_size_, ~std::size_t(0), nullptr});
     }
 
     // Counted slots [begin, end), into the ring; returns the contacts among them.
@@ -76,13 +76,16 @@ public:
     {
         if (begin >= end) return 0;
         const fast::PairKernel<PairModel<M>> kernel(list_, soa_, law_, nullptr, prefetch_ && list_.pairs() >= fast::kLanes);
-        return kernel.template run<true>(begin, end, nullptr, fast::SlotSink{ring_.data(), ring_.size() - 1, nullptr});
+        return kernel.template run<true>(begin, end, nullptr, fast::SlotSink{slots_.data(), ring_size_ - 1, nullptr});
     }
 
-    // Pair k's slot: valid from the run that wrote it until the ring comes round.
-    const fast::Slot& slot(std::size_t k) const { return k < counted_ ? ring_[k & (ring_.size() - 1)] : ghost_slots_[k - counted_]; }
+    // Where pair k's slot lies in slots(): valid from the run that wrote it until the ring comes round.
+    // The last position holds zeros.
+    std::int32_t position(std::size_t k) const { return std::int32_t(k < counted_ ? k & (ring_size_ - 1) : ring_size_ + (k - counted_)); }
+    std::int32_t zero_position() const { return std::int32_t(slots_.size() - 1); }
+    const fast::Slot* slots() const { return slots_.data(); }
 
-    std::size_t memory_bytes() const { return list_.bytes() + ghost_list_.bytes() + soa_.bytes() + fast::heap_bytes(ring_, ghost_slots_); }
+    std::size_t memory_bytes() const { return list_.bytes() + ghost_list_.bytes() + soa_.bytes() + fast::heap_bytes(slots_); }
 
 private:
     template <class Pair>
@@ -99,8 +102,8 @@ private:
     fast::LawInputs law_;
     fast::Particles soa_;         // only the kernel's records (kin) are used
     fast::NeighbourList list_, ghost_list_;  // the counted pairs, the others; only owners and partners are used
-    std::vector<fast::Slot> ring_, ghost_slots_;
-    std::size_t counted_ = 0;
+    std::vector<fast::Slot> slots_;  // a ring for the counted pairs, then a slot per other pair, then zeros
+    std::size_t counted_ = 0, ring_size_ = 1;
     bool prefetch_ = false;
 };
 

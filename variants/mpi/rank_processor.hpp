@@ -23,6 +23,7 @@
 // A pair that straddles a face is computed by both ranks from the same inputs (the same bits); no force
 // is sent back. So every owned particle receives exactly the terms arrays gives it, in arrays' order.
 #include <algorithm>
+#include <bit>
 #include <cstdint>
 #include <memory>
 #include <unordered_map>
@@ -38,6 +39,7 @@
 #include "rank_walls.hpp"
 #include "rank_particles.hpp"
 #include "rank_stretches.hpp"
+#include "rank_sum_table.hpp"
 #include "slabs.hpp"
 #include "demmat/contact_law.hpp"
 #include "demmat/contact_memory.hpp"
@@ -171,60 +173,40 @@ public:
     // walls), its loads and accelerations.
     void sum_owned(std::size_t a, std::size_t b)
     {
-        for (std::size_t l = a; l < b; ++l) {
-            Vec3d f{}, t{};
-            const std::int32_t* rows = list_.rows.data();
-            if constexpr (law) {
-                for (std::size_t e = list_.row_start[l]; e < list_.row_mid[l]; ++e) {
-                    const std::size_t k = std::size_t(rows[e]);
-                    if (!live_[k]) continue;  // a pair the law rejects adds nothing, not even a zero
-                    f = f + (-pf_[k].f_i);
-                    if constexpr (M::rotation) t = t + pf_[k].t_j;
-                }
-                for (std::size_t e = list_.row_mid[l]; e < list_.row_start[l + 1]; ++e) {
-                    const std::size_t k = std::size_t(rows[e]);
-                    if (!live_[k]) continue;
-                    f = f + pf_[k].f_i;
-                    if constexpr (M::rotation) t = t + pf_[k].t_i;
-                }
-            } else {
-                // Every listed pair's slot, zeros out of contact: they add nothing (a sum that starts
-                // at +0 is never -0, and x + ±0 = x), so the bits are those of skipping the pair.
-                for (std::size_t e = list_.row_start[l]; e < list_.row_mid[l]; ++e) {
-                    const fast::Slot& c = kernel_.slot(std::size_t(rows[e]));
-                    f = f + (-c.f);
-                    if constexpr (M::rotation) t = t + c.tj;
-                }
-                for (std::size_t e = list_.row_mid[l]; e < list_.row_start[l + 1]; ++e) {
-                    const fast::Slot& c = kernel_.slot(std::size_t(rows[e]));
-                    f = f + c.f;
-                    if constexpr (M::rotation) t = t + c.ti;
-                }
-            }
+        const std::size_t words = wall_words(walls_.size());
+        for (std::size_t l0 = a; l0 < b; l0 += kSumGroup) {
+            const std::size_t n = std::min(kSumGroup, b - l0);
+            Vec3d fs[kSumGroup]{}, ts[kSumGroup]{};
+            if constexpr (law)
+                for (std::size_t g = 0; g < n; ++g) law_pair_sum(l0 + g, fs[g], ts[g]);
+            else
+                slot_sums(l0, fs, ts);
+            for (std::size_t g = 0; g < n; ++g) {
+                const std::size_t l = l0 + g;
+                Vec3d f = fs[g], t = ts[g];
             if constexpr (M::walls && !M::memory) {
                 // Without stretches to forget, a wall that is not a candidate adds nothing: the candidates
                 // alone, in wall order.
-                for (std::size_t e = wall_start_[l]; e < wall_start_[l + 1]; ++e) {
-                    const std::size_t w = std::size_t(wall_rows_[e]);
-                    ContactForce<double> c;
-                    Stretch<double> none{};  // restitution damping alone: no stretch to carry
-                    bool live;
-                    if constexpr (law)
-                        live = wall_contact_memory<M>(p_.x[l], p_.v[l], p_.w[l], p_.r[l], p_.m[l], wp_[w], walls_[w].normal, walls_[w].velocity,
-                                                      params_, memory_, none, true, c);
-                    else
-                        live = wall_contact<M>(p_.x[l], p_.v[l], p_.w[l], p_.r[l], p_.m[l], wp_[w], walls_[w].normal, walls_[w].velocity,
-                                               params_, mono_pw_, c);
-                    if (!live) continue;
-                    ++pw_;
-                    f = f + c.f_i;
-                    if constexpr (M::rotation) t = t + c.t_i;
-                }
+                for (std::size_t q = 0; q < words; ++q)
+                    for (std::uint64_t bits = near_[l * words + q]; bits != 0; bits &= bits - 1) {
+                        const std::size_t w = 64 * q + std::size_t(std::countr_zero(bits));
+                        ContactForce<double> c;
+                        Stretch<double> none{};  // restitution damping alone: no stretch to carry
+                        bool live;
+                        if constexpr (law)
+                            live = wall_contact_memory<M>(p_.x[l], p_.v[l], p_.w[l], p_.r[l], p_.m[l], wp_[w], walls_[w].normal,
+                                                          walls_[w].velocity, params_, memory_, none, true, c);
+                        else
+                            live = wall_contact<M>(p_.x[l], p_.v[l], p_.w[l], p_.r[l], p_.m[l], wp_[w], walls_[w].normal, walls_[w].velocity,
+                                                   params_, mono_pw_, c);
+                        if (!live) continue;
+                        ++pw_;
+                        f = f + c.f_i;
+                        if constexpr (M::rotation) t = t + c.t_i;
+                    }
             } else if constexpr (M::walls) {
-                std::size_t e = wall_start_[l];
-                for (std::size_t w = 0; w < walls_.size(); ++w) {  // in wall order; the candidates are a sorted subset
-                    const bool candidate = e < wall_start_[l + 1] && std::size_t(wall_rows_[e]) == w;
-                    if (candidate) ++e;
+                for (std::size_t w = 0; w < walls_.size(); ++w) {  // in wall order
+                    const bool candidate = (near_[l * words + w / 64] >> (w % 64)) & 1u;
                     Stretch<double> none{};
                     Stretch<double>& s = M::memory ? st_.wall_row(l)[w] : none;
                     bool live = false;
@@ -251,6 +233,46 @@ public:
             p_.t[l] = t;
             p_.acc[l] = {acceleration(f.x, p_.m[l], g_.x), acceleration(f.y, p_.m[l], g_.y), acceleration(f.z, p_.m[l], g_.z)};
             if constexpr (M::rotation) p_.alc[l] = t / p_.inertia[l];
+            }
+        }
+    }
+
+    // The pair terms of the sums of the group of owned particles from l0 (rank_sum_table.hpp): every
+    // listed pair's slot counts, zeros out of contact, which add nothing, as the table's padding.
+    void slot_sums(std::size_t l0, Vec3d* f, Vec3d* t) const
+    {
+        const RankSumTable::Group& grp = sums_.group(l0 / kSumGroup);
+        const std::int32_t* at = sums_.table(grp);
+        const fast::Slot* slot = kernel_.slots();
+        for (std::size_t e = 0; e < grp.as_j; ++e, at += kSumGroup)
+            for (std::size_t g = 0; g < kSumGroup; ++g) {
+                const fast::Slot& c = slot[at[g]];
+                f[g] = f[g] + (-c.f);
+                if constexpr (M::rotation) t[g] = t[g] + c.tj;
+            }
+        for (std::size_t e = 0; e < grp.as_i; ++e, at += kSumGroup)
+            for (std::size_t g = 0; g < kSumGroup; ++g) {
+                const fast::Slot& c = slot[at[g]];
+                f[g] = f[g] + c.f;
+                if constexpr (M::rotation) t[g] = t[g] + c.ti;
+            }
+    }
+
+    // Under a law of physics.md §9: owned particle l's pair terms, the live pairs only.
+    void law_pair_sum(std::size_t l, Vec3d& f, Vec3d& t) const
+    {
+        const std::int32_t* rows = list_.rows.data();
+        for (std::size_t e = list_.row_start[l]; e < list_.row_mid[l]; ++e) {
+            const std::size_t k = std::size_t(rows[e]);
+            if (!live_[k]) continue;  // a pair the law rejects adds nothing, not even a zero
+            f = f + (-pf_[k].f_i);
+            if constexpr (M::rotation) t = t + pf_[k].t_j;
+        }
+        for (std::size_t e = list_.row_mid[l]; e < list_.row_start[l + 1]; ++e) {
+            const std::size_t k = std::size_t(rows[e]);
+            if (!live_[k]) continue;
+            f = f + pf_[k].f_i;
+            if constexpr (M::rotation) t = t + pf_[k].t_i;
         }
     }
 
@@ -311,9 +333,8 @@ public:
     ContactCounts counts() const override { return {comm_.sum(pp_), comm_.sum(pw_), comm_.sum(candidates_)}; }
     std::size_t memory_bytes() const override
     {
-        return p_.memory_bytes() + st_.memory_bytes() + list_.memory_bytes() + wall_start_.capacity() * sizeof(std::size_t) +
-               wall_rows_.capacity() * sizeof(std::int32_t) + near_.capacity() * sizeof(std::uint64_t) + pf_.capacity() * sizeof(ContactForce<double>) +
-               live_.capacity() + kernel_.memory_bytes() + order_.bytes() + fast::heap_bytes(order_x_, order_id_, order_from_);
+        return p_.memory_bytes() + st_.memory_bytes() + list_.memory_bytes() + near_.capacity() * sizeof(std::uint64_t) + pf_.capacity() * sizeof(ContactForce<double>) +
+               live_.capacity() + kernel_.memory_bytes() + sums_.memory_bytes() + order_.bytes() + fast::heap_bytes(order_x_, order_id_, order_from_);
     }
     ModelFeatures model() const override { return ModelFeatures::of<M>(); }
 
@@ -330,6 +351,7 @@ public:
 private:
     using Pair = RankList::Pair;
     static constexpr std::size_t kSumBlock = 256;  // owned particles per block of forces()
+    static constexpr std::size_t kSumGroup = RankSumTable::kGroup;  // sums made side by side (slot_sums)
 
     // A law of physics.md §9: each listed pair through the scalar law, its stretch in and out.
     void law_pairs()
@@ -568,11 +590,14 @@ private:
     void find_pairs()
     {
         list_.build(p_, plan_.cell, plan_.skin, kSumBlock);
-        if constexpr (!law) kernel_.set_pairs(list_.pairs, list_.counted, list_.reach);
+        if constexpr (!law) {
+            kernel_.set_pairs(list_.pairs, list_.counted, list_.reach);
+            sums_.build(list_, p_.owned(), [&](std::size_t k) { return kernel_.position(k); }, kernel_.zero_position());
+        }
     }
 
     // The walls each owned particle may touch, in wall order.
-    void find_walls() { list_wall_candidates(p_, walls_, wp_, wall_start_, wall_rows_, near_); }
+    void find_walls() { mark_wall_candidates(p_, walls_, wp_, near_); }
 
     static constexpr bool law = M::restitution_damping || M::history || M::rolling;  // a §9 law, not the paper's
 
@@ -597,13 +622,12 @@ private:
     RankParticles p_;
     std::vector<double> down_, up_, from_down_, from_up_;  // exchange buffers, kept between steps
     RankList list_;
-    std::vector<std::size_t> wall_start_;
-    std::vector<std::int32_t> wall_rows_;
     std::vector<std::uint64_t> near_;  // find_walls: a bit per wall that each owned particle may touch
     std::vector<ContactForce<double>> pf_;
     std::vector<char> live_;
     std::int64_t pp_ = 0, pw_ = 0, candidates_ = 0;
     RankPairKernel<M> kernel_;        // the paper's law: the pairs on lanes
+    RankSumTable sums_;               // the paper's law: the slots each group of sums reads
     fast::CellOrder order_;           // sort_owned's scratch
     std::vector<double> order_x_;
     std::vector<fast::Index> order_id_;
