@@ -14,9 +14,11 @@
 //            velocity, angular velocity of the same particles, in the same order). A particle moves
 //            less than half the skin between rebuilds, so the list holds every contact (the law decides)
 //   forces   each pair's force once per rank, by the shared law with the lower id as i: under the
-//            paper's law by the shared pair kernel on lanes (rank_pair_kernel.hpp, fast's kernel), under
-//            a law of physics.md §9 by the scalar law; each owned particle's sum in the canonical order
-//            (partners ascending by id, then walls in order)
+//            paper's law by the shared pair kernel on lanes (rank_pair_kernel.hpp, fast's kernel), a
+//            block of owned particles' pairs into a ring of slots and then the block's sums, four at a
+//            time (rank_sum_table.hpp); under a law of physics.md §9 by the scalar law. Each owned
+//            particle's sum in the canonical order (partners ascending by id, then walls in order).
+//            The owned particles are in cell order from each rebuild (sort_owned), for locality
 //   correct  marks the Gear corrector pending: the next predict's pass applies it, snapshot and save
 //            apply it to what they gather
 //
