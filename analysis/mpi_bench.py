@@ -9,7 +9,7 @@ Writes, in --out:
   halo_mpi.csv     one row per (N, R): particles, ghosts, messages and bytes per step per rank (mean, max)
   halo_mpi.md      the same as a table
   imbalance_mpi.csv, .md  particles per rank (max/mean at the end, the most a rank held/mean) of the static
-                   slabs on the bed and the compression stage, cut by count and evenly, at R = 2 and 4
+                   bricks on the bed and the compression stage, cut by count and evenly, at R = 2 and 4
 Usage: mpi_bench.py --work DIR --versions FILE --out DIR
 """
 import argparse
@@ -68,7 +68,8 @@ def halo(work):
                      "ghosts_mean": t["ghosts"].mean(), "ghosts_max": t["ghosts"].max(),
                      "messages_per_step_mean": t["messages_per_step"].mean(), "messages_per_step_max": t["messages_per_step"].max(),
                      "bytes_per_step_mean": t["bytes_per_step"].mean(), "bytes_per_step_max": t["bytes_per_step"].max(),
-                     "axis": r.meta["decomposition"]["axis"], "face_area_m2": r.meta["decomposition"].get("face_area_m2"),
+                     "grid": r.meta["decomposition"].get("grid", "slabs along " + str(r.meta["decomposition"].get("axis"))),
+                     "face_area_m2": r.meta["decomposition"].get("face_area_m2"),
                      "halo_m": r.meta["decomposition"].get("halo_m")})
     return pd.DataFrame(rows).sort_values(["N", "R"]) if rows else pd.DataFrame()
 
@@ -83,6 +84,7 @@ def imbalance(work):
         most = max(q["particles_most"] for q in ranks)
         mean = t["particles"].mean()
         rows.append({"N": int(n), "stage": stage, "balance": balance, "R": int(np_), "steps": r.meta["steps"],
+                     "grid": r.meta["decomposition"].get("grid", "slabs"),
                      "max_over_mean": t["particles"].max() / mean, "most_held_over_mean": most / mean,
                      "min_over_mean": t["particles"].min() / mean})
     return pd.DataFrame(rows).sort_values(["N", "stage", "balance", "R"]) if rows else pd.DataFrame()
@@ -141,12 +143,12 @@ def main():
         h.to_csv(os.path.join(a.out, "halo_mpi.csv.tmp"), index=False)
         os.replace(os.path.join(a.out, "halo_mpi.csv.tmp"), os.path.join(a.out, "halo_mpi.csv"))
         lines = ["# Halo traffic of the mpi variant per step per rank (scripts/run_mpi_bench.sh)", "",
-                 f"Suite: {results.provenance_line(prov)}. The dense bed's lattice, slabs along its longest axis; "
-                 "messages and bytes sent per step per rank (ghosts and migrants), mean and max over the ranks.", "",
-                 "| N | R | particles per rank (mean, max) | ghosts per rank (mean, max) | messages per step (mean, max) | bytes per step (mean, max) |",
-                 "|---|---|---|---|---|---|"]
+                 f"Suite: {results.provenance_line(prov)}. The dense bed's lattice on the grid of bricks the planner chose "
+                 "(the least cut area); messages and bytes sent per step per rank (ghosts and migrants), mean and max over the ranks.", "",
+                 "| N | R | grid | particles per rank (mean, max) | ghosts per rank (mean, max) | messages per step (mean, max) | bytes per step (mean, max) |",
+                 "|---|---|---|---|---|---|---|"]
         for _, r in h.iterrows():
-            lines.append(f"| {r.N} | {r.R} | {r.particles_mean:.0f}, {r.particles_max:.0f} | {r.ghosts_mean:.0f}, {r.ghosts_max:.0f} | "
+            lines.append(f"| {r.N} | {r.R} | {r.grid} | {r.particles_mean:.0f}, {r.particles_max:.0f} | {r.ghosts_mean:.0f}, {r.ghosts_max:.0f} | "
                          f"{r.messages_per_step_mean:.2f}, {r.messages_per_step_max:.2f} | {r.bytes_per_step_mean:.0f}, {r.bytes_per_step_max:.0f} |")
         write_text(os.path.join(a.out, "halo_mpi.md"), "\n".join(lines) + "\n")
 
@@ -154,12 +156,12 @@ def main():
     if not im.empty:
         im.to_csv(os.path.join(a.out, "imbalance_mpi.csv.tmp"), index=False)
         os.replace(os.path.join(a.out, "imbalance_mpi.csv.tmp"), os.path.join(a.out, "imbalance_mpi.csv"))
-        lines = ["# Imbalance of the static slabs (scripts/run_mpi_bench.sh)", "",
+        lines = ["# Imbalance of the static bricks (scripts/run_mpi_bench.sh)", "",
                  f"Suite: {results.provenance_line(prov)}. Particles per rank over their mean after the run (max, min), and "
-                 "the most any rank held during it over the mean; slabs cut at init by count (quantiles) or evenly.", "",
-                 "| N | stage | cut | R | steps | max/mean | min/mean | most held/mean |", "|---|---|---|---|---|---|---|---|"]
+                 "the most any rank held during it over the mean; bricks cut at init along each axis by count (quantiles) or evenly.", "",
+                 "| N | stage | cut | R | grid | steps | max/mean | min/mean | most held/mean |", "|---|---|---|---|---|---|---|---|---|"]
         for _, r in im.iterrows():
-            lines.append(f"| {r.N} | {r.stage} | {r.balance} | {r.R} | {r.steps} | {r.max_over_mean:.3f} | {r.min_over_mean:.3f} | "
+            lines.append(f"| {r.N} | {r.stage} | {r.balance} | {r.R} | {r.grid} | {r.steps} | {r.max_over_mean:.3f} | {r.min_over_mean:.3f} | "
                          f"{r.most_held_over_mean:.3f} |")
         write_text(os.path.join(a.out, "imbalance_mpi.md"), "\n".join(lines) + "\n")
 

@@ -6,8 +6,9 @@ Per step, on the slowest rank:
 n particles owned, G ghosts, M messages and B bytes sent per step by the rank, P ranks per node sharing the
 node's link of bandwidth β, latency α per message; κ = 1 (a ghost costs as much as an owned particle: an
 upper bound, checked below against R = 2). Domains are cubes of the bed's number density n_v = σ/h.
-  slabs  (what variants/mpi runs): G = 2·σ·A, M = 4, A the global cross-section; needs each slab >= h thick
-  bricks (a 3-D grid, not implemented): a cube of side L per rank, G = 6·σ·L², M = 12 (two rounds, six faces)
+  slabs  (variants/mpi on an R×1×1 grid): G = 2·σ·A, M = 4, A the global cross-section; needs each slab >= h thick
+  bricks (variants/mpi on a 3-D grid): a cube of side L per rank, G = n_v·((L + 2h)³ − L³) (the shell the staged
+         exchange fills: faces, edges and corners), M = 12 (6 neighbours, 2 messages each at a rebuild; 1 between)
 Writes scaling.csv and scaling.md in --out.
 Usage: mpi_scaling.py --bench bench_mpi.json --halo halo_mpi.csv --out DIR [--latency-us 1.0] [--bandwidth-gbs 25]
                       [--ranks-per-node 64]
@@ -42,7 +43,7 @@ def layouts(n_per_rank, n_total, ranks, p):
     g = 2.0 * sigma * side * side
     out.append(("slabs", g, 4, g * b, side / ranks >= h))
     lr = (n_per_rank / nv) ** (1.0 / 3.0)
-    g = 6.0 * sigma * lr * lr
+    g = nv * ((lr + 2.0 * h) ** 3 - lr ** 3)
     out.append(("bricks", g, 12, g * b, lr >= h))
     return out
 
@@ -115,7 +116,7 @@ def main():
           "measured against the model | measured communicate |",
           "|---|---|---|---|---|---|"] + check + ["",
           "## Weak and strong scaling", "",
-          "| scaling | decomposition | N | nodes | ranks | particles per rank | ghosts per rank | step (s) | of it network (s) | efficiency | slabs thick enough |",
+          "| scaling | decomposition | N | nodes | ranks | particles per rank | ghosts per rank | step (s) | of it network (s) | efficiency | every brick at least h thick |",
           "|---|---|---|---|---|---|---|---|---|---|---|"]
     for _, r in df.iterrows():
         md.append(f"| {r.scaling} | {r.decomposition} | {r.N:.3g} | {r.nodes} | {r.ranks} | {r.per_rank:.3g} | {r.ghosts:.3g} | "

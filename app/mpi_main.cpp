@@ -38,7 +38,7 @@ using namespace demmat::mpi;
 namespace {
 
 struct Args {
-    std::string scene, variant = "mpi", variants = "arrays,mpi", json_file, save_file, balance = "count";
+    std::string scene, variant = "mpi", variants = "arrays,mpi", json_file, save_file, balance = "count", grid = "auto";
     std::int64_t steps = 1000, repetitions = 5, warmup = 20;
     double time = 0.0;
     bool quiet = false, allow_unstable = false;
@@ -50,6 +50,13 @@ MpiOptions options_of(const Args& a)
     if (a.balance == "count") o.balance = Balance::count;
     else if (a.balance == "even") o.balance = Balance::even;
     else throw Error(fmt::format("unknown --balance '{}' (expected count or even)", a.balance));
+    if (a.grid != "auto") {
+        int x = 0, y = 0, z = 0;
+        char t1 = 0, t2 = 0, rest = 0;
+        if (std::sscanf(a.grid.c_str(), "%d%c%d%c%d%c", &x, &t1, &y, &t2, &z, &rest) != 5 || t1 != 'x' || t2 != 'x' || x < 1 || y < 1 || z < 1)
+            throw Error(fmt::format("--grid '{}' is not auto or PxPyPz with positive counts (e.g. 2x2x1)", a.grid));
+        o.grid = {x, y, z};
+    }
     return o;
 }
 
@@ -109,8 +116,8 @@ int cmd_run(const Comm& comm, const Args& a)
     if (!comm.root()) return 0;
     const double ke = kinetic_energy(snap, p->setup());
     const double n = double(p->size());
-    std::cout << fmt::format("variant mpi  scene {}  particles {}  steps {}  t = {:.6g} s  processes {}\n", p->scene().name,
-                             p->size(), steps, driver.time(), comm.size());
+    std::cout << fmt::format("variant mpi  scene {}  particles {}  steps {}  t = {:.6g} s  processes {} (bricks {})\n", p->scene().name,
+                             p->size(), steps, driver.time(), comm.size(), v->bricks().grid());
     if (!p->scene().contact_model.is_paper())
         std::cout << "contact law " << describe_law(p->scene().contact_model, p->setup().memory) << "\n";
     std::cout << fmt::format("model {}  (the scene needs {})\n", v->model().name(), features_of(p->scene(), p->state()).name());
@@ -189,8 +196,8 @@ int cmd_bench(const Comm& comm, const Args& a)
     if (!comm.root()) return 0;
     const RunReport med = median_report(reps);
     const double n = double(p->size());
-    std::cout << fmt::format("variant mpi  scene {}  particles {}  processes {}  ({} repetitions of {} steps after {} warm-up steps)\n",
-                             p->scene().name, p->size(), comm.size(), a.repetitions, a.steps, a.warmup);
+    std::cout << fmt::format("variant mpi  scene {}  particles {}  processes {} (bricks {})  ({} repetitions of {} steps after {} warm-up steps)\n",
+                             p->scene().name, p->size(), comm.size(), last->bricks().grid(), a.repetitions, a.steps, a.warmup);
     print_report(std::cout, med, n);
     if (!a.json_file.empty()) {
         json j = {{"provenance", provenance_json()},
@@ -229,7 +236,8 @@ int main(int argc, char** argv)
         c->add_option("scene", a.scene, "Scene file (TOML)")->required();
         auto* s = c->add_option("--steps,-n", a.steps, "Number of steps")->check(integer_in(1, kMaxSteps));
         c->add_option("--time,-t", a.time, "Simulated time (s), instead of --steps")->excludes(s)->check(number_from(0.0, true));
-        c->add_option("--balance", a.balance, "Where the slabs are cut: count (about N/R particles each, the default) or even (equal widths)");
+        c->add_option("--balance", a.balance, "Where the bricks are cut along each axis: count (at the quantiles of the particles, the default) or even (equal widths)");
+        c->add_option("--grid", a.grid, "Bricks along x, y and z, as PxPyPz (their product the process count), or auto (the default: the grid whose cuts have the least area)");
         c->add_flag("--allow-unstable", a.allow_unstable, "Run even with a time step above the Rayleigh time, without warning");
     };
     auto* run = app.add_subcommand("run", "Run a scene with the mpi variant and report per-phase times and the decomposition");

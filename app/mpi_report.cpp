@@ -108,9 +108,11 @@ nlohmann::json report_json(const RunReport& r, const MpiVariant& v)
                          {"rebuilds_per_step", per_step(q, q.report.rebuilds)},
                          {"seconds_per_step", {{"predict", q.per_step.predict}, {"communicate", q.communicate}, {"search", q.per_step.search},
                                                {"forces", q.per_step.forces}, {"correct", q.per_step.correct}, {"total", q.total()}}}});
-    const Slabs& s = v.slabs();
-    std::vector<double> cuts(s.cuts.begin() + 1, s.cuts.end() - 1);  // the interior planes (the ends are infinite)
-    return {{"processes", r.ranks.size()}, {"axis", std::string(1, "xyz"[s.axis])}, {"cuts", cuts}, {"face_area_m2", s.face_area},
+    const Bricks& b = v.bricks();
+    nlohmann::json cuts;
+    for (std::size_t a = 0; a < 3; ++a)  // the interior planes (the ends are infinite)
+        cuts[std::string(1, "xyz"[a])] = std::vector<double>(b.cuts[a].begin() + 1, b.cuts[a].end() - 1);
+    return {{"processes", r.ranks.size()}, {"grid", b.grid()}, {"cuts", cuts}, {"face_area_m2", b.shared_area_per_rank()},
             {"halo_m", v.halo()}, {"steps", r.steps},
             {"seconds_per_step_slowest_rank", r.total()}, {"ranks", ranks}};
 }

@@ -173,7 +173,10 @@ void Driver::run(std::int64_t steps, const std::function<void(std::int64_t)>& af
     const int interval = setup_.scene->checks.interval;
     for (std::int64_t k = 1; k <= steps; ++k) {
         step();
-        if (interval > 0 && (steps_taken_ % interval == 0 || k == steps)) check_health();
+        if (interval > 0 && (steps_taken_ % interval == 0 || k == steps)) {
+            check_health();
+            variant_.rejoin();
+        }
         if (after_step) after_step(k);
     }
 }

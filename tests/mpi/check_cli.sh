@@ -1,8 +1,8 @@
 #!/bin/sh
-# demmat_mpi on the command line (ctest mpi.cli): bad input (a process count that leaves a slab thinner
-# than the interaction range, another variant, a subcommand that stays with demmat) gets one line from
-# rank 0 and a non-zero exit on every rank; compare finds arrays and mpi identical; a state saved at
-# R = 3 and continued at R = 2 (a new stage: the compression wall moves) is the state arrays writes,
+# demmat_mpi on the command line (ctest mpi.cli): bad input (a process count that leaves a brick thinner
+# than the interaction range, a grid that is not one brick per process, another variant, a subcommand
+# that stays with demmat) gets one line from rank 0 and a non-zero exit on every rank; compare finds
+# arrays and mpi identical; a state saved at R = 3 and continued at R = 2 (a new stage: the compression wall moves) is the state arrays writes,
 # byte for byte, under the paper's law and under a law with memory (the stretches saved and reloaded).
 # Usage: check_cli.sh DEMMAT DEMMAT_MPI SOURCE_DIR WORK MPIRUN...
 set -eu
@@ -21,6 +21,8 @@ refused() {
     grep -q "$want" err.txt || { cat err.txt >&2; fail "no '$want' in the error of: $*"; }
 }
 refused "thinner than the interaction range" 3 "$demmat_mpi" run "$src/scenes/head_on.toml" --steps 10
+refused "not one per process" 2 "$demmat_mpi" run "$src/scenes/head_on.toml" --grid 3x1x1
+refused "is not auto or PxPyPz" 2 "$demmat_mpi" run "$src/scenes/head_on.toml" --grid 2x1
 refused "runs the mpi variant only, not 'arrays'" 2 "$demmat_mpi" run "$src/scenes/head_on.toml" --variant arrays
 refused "run it with demmat" 2 "$demmat_mpi" scene paper
 refused "cannot open" 2 "$demmat_mpi" run no_such_scene.toml

@@ -3,6 +3,8 @@
 // snapshots bit for bit after init and after every step. Every rank takes the same path through each
 // test (the collective calls must match), so the tests use EXPECT, never ASSERT, and only rank 0 holds
 // the data they check. Suites named *Long are the long runs (ctest label long).
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <functional>
 #include <memory>
@@ -34,7 +36,7 @@ struct Lockstep {
     std::vector<RankReport> reports;   // rank 0: every rank's share after the run
     ContactCounts counts;
     Snapshot last;                     // rank 0: the mpi variant's last snapshot
-    Slabs slabs;
+    Bricks bricks;
     std::size_t particles = 0;
     double halo = 0.0;
 };
@@ -51,7 +53,7 @@ Lockstep run_lockstep(const std::function<std::unique_ptr<Problem>()>& load, std
     out.steps = r.steps;
     out.reports = mpi->rank_reports();
     out.counts = mpi->counts();
-    out.slabs = mpi->slabs();
+    out.bricks = mpi->bricks();
     out.particles = problem->size();
     out.halo = mpi->halo();
     return out;
@@ -66,8 +68,8 @@ std::unique_ptr<Problem> bed(double wall_speed)
     return std::make_unique<Problem>(s, st);
 }
 
-// A loose gas of fast grains (3 to 6 m/s, no gravity) in a box of 0.24 × 0.12 × 0.12 m, slabs along x:
-// a grain crosses a slab of 3 cm (R = 8) in about 700 steps, so grains cross the faces again and again;
+// A loose gas of fast grains (3 to 6 m/s, no gravity) in a box of 0.24 × 0.12 × 0.12 m: a grain
+// crosses a brick of 3 cm (8 along x) in about 700 steps, so grains cross the faces again and again;
 // polydisperse, walls, friction, damping.
 std::unique_ptr<Problem> gas()
 {
@@ -132,7 +134,7 @@ TEST(MpiEquivalence, CompressionStageIsBitIdenticalToArraysAtEveryStep)
     expect_identical(r, long_run(200));
 }
 
-TEST(MpiEquivalence, LooseGasCrossingTheSlabsIsBitIdentical)
+TEST(MpiEquivalence, LooseGasCrossingTheBricksIsBitIdentical)
 {
     const std::int64_t steps = 800;  // a thousand grains: cheap in the sanitizer build too, and the crossings need the steps
     const Lockstep r = run_lockstep(gas, steps);
@@ -140,11 +142,36 @@ TEST(MpiEquivalence, LooseGasCrossingTheSlabsIsBitIdentical)
     if (world().root() && world().size() > 1) {
         std::int64_t migrants = 0;
         for (const RankReport& q : r.reports) migrants += q.migrants;
-        EXPECT_GT(migrants, 40 * (world().size() - 1)) << "the gas should cross the slabs' faces";
+        EXPECT_GT(migrants, 40 * (world().size() - 1)) << "the gas should cross the bricks' faces";
     }
 }
 
-TEST(MpiEquivalence, EvenSlabsGiveTheSameBits)
+// The gas on a grid that cuts as many axes as the process count allows (2: along z; 3: along y; 4: 2x2
+// in x and y; 8: 2x2x2), so that grains migrate across edges and corners, through a neighbour, and
+// ghosts reach the bricks across an edge or a corner through the staged exchange.
+TEST(MpiEquivalence, LooseGasOnBricksInEveryDirectionIsBitIdentical)
+{
+    const int ranks = world().size();
+    MpiOptions grid;
+    grid.grid = ranks == 2 ? std::array<int, 3>{1, 1, 2} : ranks == 3 ? std::array<int, 3>{1, 3, 1} : ranks == 4 ? std::array<int, 3>{2, 2, 1}
+              : ranks == 8 ? std::array<int, 3>{2, 2, 2} : std::array<int, 3>{ranks, 1, 1};
+    const std::int64_t steps = 800;
+    const Lockstep r = run_lockstep(gas, steps, grid);
+    expect_identical(r, steps);
+    if (!world().root()) return;
+    EXPECT_EQ(r.bricks.dims, grid.grid);
+    if (ranks >= 4) {
+        std::int64_t migrants = 0, ghosts = 0;
+        for (const RankReport& q : r.reports) {
+            migrants += q.migrants;
+            ghosts += q.ghosts;
+        }
+        EXPECT_GT(migrants, 40 * (ranks - 1)) << "the gas should cross the bricks' faces";
+        EXPECT_GT(ghosts, 0);
+    }
+}
+
+TEST(MpiEquivalence, EvenCutsGiveTheSameBits)
 {
     MpiOptions even;
     even.balance = Balance::even;
@@ -164,31 +191,26 @@ TEST(MpiEquivalence, EachRankHoldsItsShareAndItsHaloOnly)
         owned += q.owned;
         EXPECT_LE(double(q.owned_max), 1.25 * double(r.particles) / ranks + 10) << "rank " << q.rank;
         EXPECT_GE(double(q.owned), 0.75 * double(r.particles) / ranks - 10) << "rank " << q.rank;
-        // The ghosts are the neighbours' particles within the halo of a shared face (counted here from
-        // the last positions, with slack for one step's motion).
-        const int axis = r.slabs.axis;
+        // The ghosts are the other bricks' particles within the halo of this one (across a face, an edge
+        // or a corner), counted here from the last positions, with slack for one step's motion.
         std::int64_t near = 0, close = 0;
         for (const Vec3d& x : r.last.position) {
-            const double c = component(x, axis);
-            const int o = r.slabs.owner(c);
-            if (o == q.rank - 1) {
-                const double d = r.slabs.cuts[std::size_t(q.rank)] - c;
-                near += d < 1.5 * r.halo;
-                close += d < 0.5 * r.halo;
-            } else if (o == q.rank + 1) {
-                const double d = c - r.slabs.cuts[std::size_t(q.rank) + 1];
-                near += d < 1.5 * r.halo;
-                close += d < 0.5 * r.halo;
-            }
+            if (r.bricks.owner(x) == q.rank) continue;
+            double d = 0.0;  // how far outside the brick, along the axis where it is farthest
+            for (int a = 0; a < 3; ++a)
+                d = std::max({d, r.bricks.low(q.rank, a) - component(x, a), component(x, a) - r.bricks.high(q.rank, a)});
+            near += d < 1.5 * r.halo;
+            close += d < 0.5 * r.halo;
         }
         EXPECT_LE(q.ghosts, near) << "rank " << q.rank;
         EXPECT_GE(q.ghosts, close) << "rank " << q.rank;
         if (ranks == 1) {
             EXPECT_EQ(q.ghosts, 0);
         }
-        // A message to each neighbour per step (the ghosts refreshed), and one more at a rebuild (migrants,
-        // then the new ghosts).
-        const int neighbours = (q.rank > 0) + (q.rank + 1 < ranks);
+        // A message to each face neighbour per step (the ghosts refreshed), and one more at a rebuild
+        // (migrants, then the new ghosts).
+        int neighbours = 0;
+        for (int a = 0; a < 3; ++a) neighbours += (r.bricks.neighbour(q.rank, a, -1) >= 0) + (r.bricks.neighbour(q.rank, a, 1) >= 0);
         EXPECT_EQ(q.traffic.messages, neighbours * (q.steps + q.rebuilds)) << "rank " << q.rank;
         EXPECT_LT(q.rebuilds, q.steps) << "the list is kept over several steps";
     }
@@ -228,7 +250,7 @@ TEST(MpiEquivalenceLong, CompressionStageIsBitIdenticalToArraysAtEveryStep)
     expect_identical(r, long_run(3000));
 }
 
-TEST(MpiEquivalenceLong, LooseGasCrossingTheSlabsIsBitIdentical)
+TEST(MpiEquivalenceLong, LooseGasCrossingTheBricksIsBitIdentical)
 {
     const Lockstep r = run_lockstep(gas, long_run(8000));
     expect_identical(r, long_run(8000));

@@ -10,12 +10,12 @@ Comm::Comm(MPI_Comm comm) : comm_(comm)
     MPI_Comm_size(comm_, &size_);
 }
 
-void Comm::exchange(const std::vector<double>& to_lower, const std::vector<double>& to_upper, std::vector<double>& from_lower,
-                    std::vector<double>& from_upper, int tag)
+void Comm::exchange(int lower_rank, int upper_rank, const std::vector<double>& to_lower, const std::vector<double>& to_upper,
+                    std::vector<double>& from_lower, std::vector<double>& from_upper, int tag)
 {
     const auto t0 = std::chrono::steady_clock::now();
-    const int lower = rank_ > 0 ? rank_ - 1 : MPI_PROC_NULL;
-    const int upper = rank_ + 1 < size_ ? rank_ + 1 : MPI_PROC_NULL;
+    const int lower = lower_rank >= 0 ? lower_rank : MPI_PROC_NULL;
+    const int upper = upper_rank >= 0 ? upper_rank : MPI_PROC_NULL;
     MPI_Request req[2];
     // The sizes travel with the messages (MPI_Probe): one message per neighbour and direction.
     MPI_Isend(to_lower.data(), int(to_lower.size()), MPI_DOUBLE, lower, tag, comm_, &req[0]);
@@ -111,5 +111,7 @@ double Comm::max(double v) const
     MPI_Allreduce(&v, &out, 1, MPI_DOUBLE, MPI_MAX, comm_);
     return out;
 }
+
+void Comm::barrier() const { MPI_Barrier(comm_); }
 
 } // namespace demmat::mpi

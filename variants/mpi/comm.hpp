@@ -1,5 +1,5 @@
 #pragma once
-// The MPI calls of the mpi variant, in one place: the exchange with the two slab neighbours (counted:
+// The MPI calls of the mpi variant, in one place: the exchange with two brick neighbours (counted:
 // messages, bytes, seconds), and the gathers and broadcasts that rank 0 uses for observables and setup.
 // Every buffer is doubles; an id travels as the bits of an int64 (id_to_double), exactly.
 #include <bit>
@@ -29,10 +29,10 @@ public:
     MPI_Comm handle() const { return comm_; }
     bool root() const { return rank_ == 0; }
 
-    // Sends `to_lower` to rank−1 and `to_upper` to rank+1 (none past either end) and returns what they
-    // sent this rank, in one round of two messages each way. `tag` keeps rounds apart.
-    void exchange(const std::vector<double>& to_lower, const std::vector<double>& to_upper, std::vector<double>& from_lower,
-                  std::vector<double>& from_upper, int tag);
+    // Sends `to_lower` to rank `lower` and `to_upper` to rank `upper` (−1: none) and returns what they
+    // sent this rank, in one round of a message each way with each. `tag` keeps rounds apart.
+    void exchange(int lower, int upper, const std::vector<double>& to_lower, const std::vector<double>& to_upper,
+                  std::vector<double>& from_lower, std::vector<double>& from_upper, int tag);
     const Traffic& traffic() const { return traffic_; }
 
     // Rank 0 receives every rank's buffer, concatenated in rank order; the others get an empty vector.
@@ -45,6 +45,7 @@ public:
     // True on every rank when `flag` is on some rank; timed into traffic().seconds (it is a step's exchange).
     bool any(bool flag);
     double max(double v) const;
+    void barrier() const;  // not counted as traffic: it is not a step's exchange
 
 private:
     MPI_Comm comm_;

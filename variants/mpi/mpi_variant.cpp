@@ -1,4 +1,4 @@
-// The mpi variant's entry: the plan rank 0 makes at init (the model, the slabs), sent to every rank, and
+// The mpi variant's entry: the plan rank 0 makes at init (the model, the bricks), sent to every rank, and
 // the instantiation for that model (with_model, as the specialising variants pick theirs).
 #include "mpi_variant.hpp"
 
@@ -20,9 +20,11 @@ constexpr double kSkin = 0.3;
 std::vector<double> plan_to_doubles(const Plan& p)
 {
     const ModelFeatures& f = p.features;
+    const Bricks& b = p.bricks;
     std::vector<double> d = {double(f.rotation), double(f.friction), double(f.damping), double(f.walls), double(f.moving_walls),
-                             double(f.polydisperse), double(p.slabs.axis), p.radius_max, p.cell, p.halo, p.r0, p.m0, p.slabs.face_area, p.skin};
-    d.insert(d.end(), p.slabs.cuts.begin(), p.slabs.cuts.end());
+                             double(f.polydisperse), p.radius_max, p.cell, p.halo, p.r0, p.m0, p.skin,
+                             double(b.dims[0]), double(b.dims[1]), double(b.dims[2]), b.area[0], b.area[1], b.area[2]};
+    for (const std::vector<double>& c : b.cuts) d.insert(d.end(), c.begin(), c.end());
     return d;
 }
 
@@ -30,15 +32,19 @@ Plan plan_from_doubles(const std::vector<double>& d)
 {
     Plan p;
     p.features = {d[0] != 0.0, d[1] != 0.0, d[2] != 0.0, d[3] != 0.0, d[4] != 0.0, d[5] != 0.0};
-    p.slabs.axis = int(d[6]);
-    p.radius_max = d[7];
-    p.cell = d[8];
-    p.halo = d[9];
-    p.r0 = d[10];
-    p.m0 = d[11];
-    p.slabs.face_area = d[12];
-    p.skin = d[13];
-    p.slabs.cuts.assign(d.begin() + 14, d.end());
+    p.radius_max = d[6];
+    p.cell = d[7];
+    p.halo = d[8];
+    p.r0 = d[9];
+    p.m0 = d[10];
+    p.skin = d[11];
+    auto at = d.begin() + 18;
+    for (std::size_t a = 0; a < 3; ++a) {
+        p.bricks.dims[a] = int(d[12 + a]);
+        p.bricks.area[a] = d[15 + a];
+        p.bricks.cuts[a].assign(at, at + p.bricks.dims[a] + 1);
+        at += p.bricks.dims[a] + 1;
+    }
     return p;
 }
 
@@ -62,7 +68,7 @@ Plan share_plan(const Comm& comm, const Setup& setup, const MpiOptions& options)
             p.r0 = s.radius[0];
             p.m0 = setup.mass[0];
         }
-        failure = plan_slabs(s.trans.x, comm.size(), p.halo, options.balance, p.slabs);
+        failure = plan_bricks(s.trans.x, comm.size(), p.halo, options.balance, options.grid, p.bricks);
         data = plan_to_doubles(p);
     }
     comm.broadcast(failure);
@@ -97,6 +103,7 @@ public:
     void save(State& out) const override { impl_->save(out); }
     ContactCounts counts() const override { return impl_ ? impl_->counts() : ContactCounts{}; }
     std::size_t memory_bytes() const override { return impl_ ? impl_->memory_bytes() : 0; }
+    void rejoin() const override { comm().barrier(); }  // after rank 0's health check
     ModelFeatures model() const override { return impl_ ? impl_->model() : ModelFeatures::full(); }
     const Comm& comm() const override { return impl_ ? impl_->comm() : comm_; }
     RankReport local_report() const override
@@ -107,7 +114,7 @@ public:
         return r;
     }
     double communicate_seconds() const override { return impl_ ? impl_->communicate_seconds() : 0.0; }
-    const Slabs& slabs() const override { return impl_->slabs(); }
+    const Bricks& bricks() const override { return impl_->bricks(); }
     double halo() const override { return impl_->halo(); }
 
 private:

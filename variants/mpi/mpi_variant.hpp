@@ -1,10 +1,10 @@
 #pragma once
 // The mpi variant: the processor spread over the ranks of an MPI communicator by spatial domain
-// decomposition (slabs.hpp), bit-identical to arrays for any number of ranks (docs/variants.md, "mpi").
+// decomposition (bricks.hpp), bit-identical to arrays for any number of ranks (docs/variants.md, "mpi").
 // One instance per rank, each driven by its own Driver in lockstep. It is not in the registry (a
 // program that runs it must be started by mpirun): demmat_mpi and the mpi tests make it here.
 //
-// Collective calls: init and the four phases (they exchange migrants and ghosts with the slab
+// Collective calls: init and the four phases (they exchange migrants and ghosts with the brick
 // neighbours), and snapshot, save, counts and rank_reports, which every rank must call together;
 // snapshot and save fill their output on rank 0 only (the others get no particles).
 #include <cstdint>
@@ -13,7 +13,9 @@
 #include <vector>
 
 #include "comm.hpp"
-#include "slabs.hpp"
+#include <array>
+
+#include "bricks.hpp"
 #include "demmat/error.hpp"
 #include "demmat/problem.hpp"
 #include "demmat/variant.hpp"
@@ -22,6 +24,7 @@ namespace demmat::mpi {
 
 struct MpiOptions {
     Balance balance = Balance::count;
+    std::array<int, 3> grid = {0, 0, 0};  // bricks along x, y, z; zeros: the grid whose cuts have the least area
 };
 
 // One rank's share: particles owned now, ghosts received at the last step, and its traffic so far.
@@ -50,7 +53,7 @@ public:
     std::vector<RankReport> rank_reports() const;
     // This rank's seconds spent exchanging with its neighbours (inside the search phase) since init.
     virtual double communicate_seconds() const = 0;
-    virtual const Slabs& slabs() const = 0;
+    virtual const Bricks& bricks() const = 0;
     virtual double halo() const = 0;  // m: ghosts are the particles within this distance of a shared face
 };
 

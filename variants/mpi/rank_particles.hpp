@@ -1,6 +1,6 @@
 #pragma once
 // One rank's particles: the ones it owns (with their whole Gear history) followed by the ghosts, copies
-// of its neighbours' particles near the slab faces (what the law reads: position, velocity, angular
+// of its neighbours' particles near the brick faces (what the law reads: position, velocity, angular
 // velocity, radius, mass). Local index l < owned() is an owned particle, owned() <= l < size() a ghost.
 // Ids are kept beside every particle: the canonical order is by id, never by local index.
 #include <cstdint>

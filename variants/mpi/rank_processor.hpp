@@ -6,13 +6,15 @@
 //            computes the same wall positions, nothing is sent for them)
 //   search   a neighbour list with a skin, as fast keeps one: rebuilt when some particle on some rank
 //            has moved more than 0.45 skin since the last rebuild (one allreduce of a flag per step).
-//            At a rebuild, communicate: owned particles that left the slab migrate to the neighbour (with
-//            their whole Gear history), then each rank sends its neighbours ghost copies of its particles
-//            within the interaction range plus the skin of the shared face, and remembers whom it sent;
-//            the cell search over owned and ghosts lists every pair with an owned particle closer than
-//            R_i + R_j + skin (rank_list.hpp). Between rebuilds, communicate only refreshes the ghosts (position,
-//            velocity, angular velocity of the same particles, in the same order). A particle moves
-//            less than half the skin between rebuilds, so the list holds every contact (the law decides)
+//            At a rebuild, communicate (rank_halo.hpp): owned particles that left the brick migrate to
+//            the rank that owns them now (with their whole Gear history), the owned particles are sorted
+//            into cell order, then the ranks exchange ghost copies of the particles within the interaction
+//            range plus the skin of each shared face, an axis at a time, and remember whom they sent; the
+//            cell search over owned and ghosts lists every pair with an owned particle closer than
+//            R_i + R_j + skin (rank_list.hpp). Between rebuilds, communicate only refreshes the ghosts
+//            (position, velocity, angular velocity of the same particles, in the same order). A particle
+//            moves less than half the skin between rebuilds, so the list holds every contact (the law
+//            decides)
 //   forces   each pair's force once per rank, by the shared law with the lower id as i: under the
 //            paper's law by the shared pair kernel on lanes (rank_pair_kernel.hpp, fast's kernel), a
 //            block of owned particles' pairs into a ring of slots and then the block's sums, four at a
@@ -42,7 +44,8 @@
 #include "rank_particles.hpp"
 #include "rank_stretches.hpp"
 #include "rank_sum_table.hpp"
-#include "slabs.hpp"
+#include "bricks.hpp"
+#include "rank_halo.hpp"
 #include "demmat/contact_law.hpp"
 #include "demmat/contact_memory.hpp"
 #include "demmat/error.hpp"
@@ -51,10 +54,10 @@
 
 namespace demmat::mpi {
 
-// What rank 0 decides at init and every rank receives: the model, the slabs, the lengths.
+// What rank 0 decides at init and every rank receives: the model, the bricks, the lengths.
 struct Plan {
     ModelFeatures features;
-    Slabs slabs;
+    Bricks bricks;
     double radius_max = 0.0;
     double cell = 0.0;   // edge of the search's cells
     double skin = 0.0;   // the neighbour list's skin
@@ -65,7 +68,7 @@ struct Plan {
 template <class M>
 class RankProcessor final : public MpiVariant {
 public:
-    RankProcessor(const Comm& comm, const Plan& plan) : comm_(comm), plan_(plan) {}
+    RankProcessor(const Comm& comm, const Plan& plan) : comm_(comm), plan_(plan), halo_(comm, plan.bricks, plan.halo) {}
 
     void init(const Setup& setup) override
     {
@@ -84,14 +87,14 @@ public:
             mono_pw_ = wall_coefficients(plan_.r0, plan_.m0, params_);
         }
         if constexpr (!law) kernel_.init(params_, mono_pp_);
-        // Rank 0 holds the whole state: each rank receives its slab's particles as migrants.
+        // Rank 0 holds the whole state: each rank receives its brick's particles as migrants.
         std::vector<std::vector<double>> parts;
         if (comm_.root()) {
             parts.resize(std::size_t(comm_.size()));
             const std::vector<Vec3d>* g[12] = {&s.trans.x, &s.trans.v, &s.trans.a, &s.trans.b3, &s.trans.b4, &s.trans.b5,
                                                &s.rot.x,   &s.rot.v,   &s.rot.a,   &s.rot.b3,   &s.rot.b4,   &s.rot.b5};
             for (std::size_t i = 0; i < s.size(); ++i) {
-                std::vector<double>& out = parts[std::size_t(plan_.slabs.owner(component(s.trans.x[i], plan_.slabs.axis)))];
+                std::vector<double>& out = parts[std::size_t(plan_.bricks.owner(s.trans.x[i]))];
                 out.push_back(id_to_double(std::int64_t(i)));
                 out.push_back(s.radius[i]);
                 out.push_back(setup.mass[i]);
@@ -128,7 +131,7 @@ public:
         if (!built_ || must_rebuild()) {
             migrate();
             sort_owned();
-            exchange_ghosts();
+            halo_.exchange_ghosts(comm_, p_);
             find_pairs();
             if constexpr (M::memory) {  // each new pair takes its stretch by key; the others start at zero
                 st_.pair.assign(list_.pairs.size(), Stretch<double>{});
@@ -142,7 +145,7 @@ public:
             built_ = true;
             ++rebuilds_;
         } else {
-            refresh_ghosts();
+            halo_.refresh_ghosts(comm_, p_);
         }
         if constexpr (M::walls) find_walls();  // every step, without a skin: a wall may move
         ++steps_;
@@ -335,14 +338,14 @@ public:
     ContactCounts counts() const override { return {comm_.sum(pp_), comm_.sum(pw_), comm_.sum(candidates_)}; }
     std::size_t memory_bytes() const override
     {
-        return p_.memory_bytes() + st_.memory_bytes() + list_.memory_bytes() + near_.capacity() * sizeof(std::uint64_t) + pf_.capacity() * sizeof(ContactForce<double>) +
+        return p_.memory_bytes() + st_.memory_bytes() + list_.memory_bytes() + halo_.memory_bytes() + near_.capacity() * sizeof(std::uint64_t) + pf_.capacity() * sizeof(ContactForce<double>) +
                live_.capacity() + kernel_.memory_bytes() + sums_.memory_bytes() + order_.bytes() + fast::heap_bytes(order_x_, order_id_, order_from_);
     }
     ModelFeatures model() const override { return ModelFeatures::of<M>(); }
 
     const Comm& comm() const override { return comm_; }
     double communicate_seconds() const override { return comm_.traffic().seconds; }
-    const Slabs& slabs() const override { return plan_.slabs; }
+    const Bricks& bricks() const override { return plan_.bricks; }
     double halo() const override { return plan_.halo; }
     RankReport local_report() const override
     {
@@ -382,78 +385,16 @@ private:
         for (std::size_t w = 0; w < walls_.size(); ++w) wp_[w] = walls_[w].point_at(step, dt_);
     }
 
-    double axis_coordinate(std::size_t l) const { return component(p_.x[l], plan_.slabs.axis); }
-
-    // Owned particles whose predicted position left the slab go to the neighbour that now owns it.
+    // Owned particles whose predicted position left the brick go to the rank that now owns it
+    // (rank_halo.hpp). Under a law with memory every live pair's stretch waits in `pending` by its key,
+    // taken while the ghosts' ids are still here; a migrant's pairs go with it.
     void migrate()
     {
-        down_.clear();
-        up_.clear();
-        const int me = comm_.rank();
-        const std::size_t record = kMigrantDoubles + (M::memory ? walls_.size() * RankStretches::kWallDoubles : 0);
-        down_.push_back(0.0);  // the count of migrants, then their records, then (a §9 law) their pairs' stretches
-        up_.push_back(0.0);
-        std::vector<double>& down_stretches = from_down_;  // scratch until the exchange
-        std::vector<double>& up_stretches = from_up_;
-        down_stretches.clear();
-        up_stretches.clear();
-        if constexpr (M::memory) {
-            // Every live pair's stretch by its key, while the ghosts' ids are still here; a migrant's pairs
-            // go with it (the rank it joins may not hold the partner).
+        if constexpr (M::memory)
             for (std::size_t k = 0; k < list_.pairs.size() && k < live_.size(); ++k)
                 if (live_[k]) st_.pending[{p_.id[std::size_t(list_.pairs[k].i)], p_.id[std::size_t(list_.pairs[k].j)]}] = st_.pair[k];
-            for (std::size_t l = 0; l < p_.owned(); ++l) {
-                const int to = plan_.slabs.owner(axis_coordinate(l));
-                if (to == me || list_.row_start.size() <= l + 1) continue;
-                for (std::size_t e = list_.row_start[l]; e < list_.row_start[l + 1]; ++e) {
-                    const std::size_t k = std::size_t(list_.rows[e]);
-                    if (k < live_.size() && live_[k])
-                        pack_stretch(to < me ? down_stretches : up_stretches, p_.id[std::size_t(list_.pairs[k].i)],
-                                     p_.id[std::size_t(list_.pairs[k].j)], st_.pair[k]);
-                }
-            }
-        }
         p_.drop_ghosts();
-        for (std::size_t l = 0; l < p_.owned();) {
-            const int to = plan_.slabs.owner(axis_coordinate(l));
-            if (to == me) {
-                ++l;
-                continue;
-            }
-            if (to != me - 1 && to != me + 1)
-                throw InstabilityError(fmt::format("particle {} moved across more than one slab in a step (from rank {} to {}): the run "
-                                                   "has blown up", p_.id[l], me, to), -1, p_.id[l]);
-            std::vector<double>& out = to < me ? down_ : up_;
-            p_.pack_migrant(l, out);
-            out[0] += 1.0;
-            if constexpr (M::memory) {
-                st_.pack_wall_row(l, out);
-                st_.move_owned(p_.owned() - 1, l);
-            }
-            p_.remove_owned(l);
-            if constexpr (M::memory) st_.resize_owned(p_.owned());
-            ++migrants_;
-        }
-        down_.insert(down_.end(), down_stretches.begin(), down_stretches.end());
-        up_.insert(up_.end(), up_stretches.begin(), up_stretches.end());
-        comm_.exchange(down_, up_, from_down_, from_up_, 1);
-        for (const std::vector<double>* in : {&from_down_, &from_up_}) {
-            if (in->empty()) continue;
-            const std::size_t n = std::size_t((*in)[0]);
-            for (std::size_t k = 0; k < n; ++k) {
-                const double* q = &(*in)[1 + k * record];
-                p_.add_migrant(q);
-                if constexpr (M::memory) {
-                    st_.resize_owned(p_.owned());
-                    st_.set_wall_row(p_.owned() - 1, q + kMigrantDoubles);
-                }
-            }
-            if constexpr (M::memory)
-                for (std::size_t at = 1 + n * record; at + kStretchDoubles <= in->size(); at += kStretchDoubles) {
-                    const double* q = &(*in)[at];
-                    st_.pending[{double_to_id(q[0]), double_to_id(q[1])}] = unpack_stretch(q);
-                }
-        }
+        migrants_ += halo_.migrate(comm_, p_, M::memory ? &st_ : nullptr);
     }
 
     // Rank 0's state's stretches, to the ranks that own a contact's particles (both, for a pair that
@@ -465,7 +406,7 @@ private:
         std::vector<std::vector<double>> parts;
         if (comm_.root()) {
             parts.resize(std::size_t(comm_.size()));
-            auto owner = [&](std::int64_t i) { return plan_.slabs.owner(component(s.trans.x[std::size_t(i)], plan_.slabs.axis)); };
+            auto owner = [&](std::int64_t i) { return plan_.bricks.owner(s.trans.x[std::size_t(i)]); };
             for (const ContactStretch& c : s.stretches) {
                 const Stretch<double> v{c.tangential, c.rolling};
                 const int oi = owner(c.i);
@@ -531,59 +472,6 @@ private:
         if constexpr (M::memory) st_.permute_owned(order_from_);
     }
 
-    // Copies of the owned particles within the halo of a shared face, for the neighbour across it.
-    void exchange_ghosts()
-    {
-        down_.clear();
-        up_.clear();
-        const int me = comm_.rank();
-        const double lo = plan_.slabs.cuts[std::size_t(me)], hi = plan_.slabs.cuts[std::size_t(me) + 1];
-        send_down_.clear();
-        send_up_.clear();
-        for (std::size_t l = 0; l < p_.owned(); ++l) {
-            const double c = axis_coordinate(l);
-            if (me > 0 && c - lo < plan_.halo) {
-                p_.pack_ghost(l, down_);
-                send_down_.push_back(std::int32_t(l));
-            }
-            if (me + 1 < comm_.size() && hi - c < plan_.halo) {
-                p_.pack_ghost(l, up_);
-                send_up_.push_back(std::int32_t(l));
-            }
-        }
-        comm_.exchange(down_, up_, from_down_, from_up_, 2);
-        p_.add_ghosts(from_down_);
-        p_.add_ghosts(from_up_);
-        ghosts_from_down_ = from_down_.size() / kGhostDoubles;
-        ghosts_from_up_ = from_up_.size() / kGhostDoubles;
-    }
-
-    // Between rebuilds: the same particles' position, velocity and angular velocity, in the order of the
-    // rebuild, overwrite the ghosts they made.
-    void refresh_ghosts()
-    {
-        auto pack = [&](const std::vector<std::int32_t>& list, std::vector<double>& out) {
-            out.clear();
-            for (std::int32_t l : list)
-                for (const Vec3d* q : {&p_.x[std::size_t(l)], &p_.v[std::size_t(l)], &p_.w[std::size_t(l)]})
-                    for (int c = 0; c < 3; ++c) out.push_back(component(*q, c));
-        };
-        pack(send_down_, down_);
-        pack(send_up_, up_);
-        comm_.exchange(down_, up_, from_down_, from_up_, 3);
-        auto unpack = [&](const std::vector<double>& in, std::size_t count, std::size_t first) {
-            if (in.size() != 9 * count) throw Error("internal: a neighbour refreshed a different number of ghosts");
-            for (std::size_t k = 0; k < count; ++k) {
-                const double* q = &in[9 * k];
-                p_.x[first + k] = {q[0], q[1], q[2]};
-                p_.v[first + k] = {q[3], q[4], q[5]};
-                p_.w[first + k] = {q[6], q[7], q[8]};
-            }
-        };
-        unpack(from_down_, ghosts_from_down_, p_.owned());
-        unpack(from_up_, ghosts_from_up_, p_.owned() + ghosts_from_down_);
-    }
-
     // Has any particle on any rank moved more than 0.45 skin since the last rebuild (fast's criterion)?
     // Each rank's answer comes from its predict pass.
     bool must_rebuild() { return comm_.any(moved_far_); }
@@ -612,8 +500,6 @@ private:
     bool corrector_pending_ = false;  // correct() was called; the next predict applies it
     bool moved_far_ = false;          // the last predict moved some owned particle 0.45 skin from x_built_
     std::vector<Vec3d> x_built_;                         // owned positions at the last rebuild
-    std::vector<std::int32_t> send_down_, send_up_;      // the owned particles whose ghosts the neighbours hold
-    std::size_t ghosts_from_down_ = 0, ghosts_from_up_ = 0;
     double dt_ = 0.0;
     GearCoefficients<double> coef_;
     ContactParams<double> params_;
@@ -622,7 +508,7 @@ private:
     std::vector<Wall> walls_;
     std::vector<Vec3d> wp_;  // the walls' points at the current step
     RankParticles p_;
-    std::vector<double> down_, up_, from_down_, from_up_;  // exchange buffers, kept between steps
+    RankHalo halo_;  // the exchanges with the bricks around
     RankList list_;
     std::vector<std::uint64_t> near_;  // find_walls: a bit per wall that each owned particle may touch
     std::vector<ContactForce<double>> pf_;

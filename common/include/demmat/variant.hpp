@@ -65,6 +65,11 @@ public:
     virtual void save(State& out) const = 0;      // the full state, for save-and-continue
     virtual ContactCounts counts() const = 0;
     virtual std::size_t memory_bytes() const = 0;  // bytes held for particles and contacts
+    // Called by the Driver after the untimed work it does between steps (a health check: on a variant
+    // spread over processes, the one that gathered the snapshot checks it alone). Such a variant waits
+    // here for all its processes, so that the others do not time that work as waiting in the next
+    // step's exchange. Default: nothing to wait for.
+    virtual void rejoin() const {}
     // The model features the instantiation picked in init() computes (model.hpp); a variant that does
     // not specialise runs the full model.
     virtual ModelFeatures model() const { return ModelFeatures::full(); }
