@@ -72,6 +72,29 @@ class Loader(unittest.TestCase):
         self.assertEqual(fast["sample"].nunique(), 4)  # 2 configurations × 2 repetitions
         self.assertEqual(len(results.wide(r.table)), 6)
 
+    def test_summarise_fast_keys_rows_by_the_threads_asked(self):
+        # fast asked for 1 and 2 threads on a small bed runs on 1 both times: two rows, the second saying so
+        import json
+        raw = json.load(open(os.path.join(DATA, "bench_sample.json")))
+        extra = [dict(x, threads=1, threads_asked=1) for x in raw["samples"] if x["variant"] == "fast"]
+        for x in raw["samples"]:
+            if x["variant"] == "fast":
+                x["threads"], x["threads_asked"] = 1, 2
+        raw["samples"] += extra
+        fast = next(s for s in raw["summary"] if s["variant"] == "fast")
+        raw["summary"].append(dict(fast, threads=1, threads_asked=1))
+        fast.update(threads=1, threads_asked=2)
+        work = tempfile.mkdtemp()
+        try:
+            with open(os.path.join(work, "bench_settled_2000.json"), "w") as f:
+                json.dump(raw, f)
+            out = os.path.join(work, "summary.md")
+            subprocess.run([sys.executable, os.path.join(ANALYSIS, "summarise_fast.py"), work, "-o", out], check=True)
+            rows = [line for line in open(out) if line.startswith("| settled | 2000 | fast |")]
+            self.assertEqual([r.split("|")[4].strip() for r in rows], ["1", "2 (ran on 1)"])
+        finally:
+            shutil.rmtree(work)
+
     def test_google_benchmark(self):
         r = results.load(os.path.join(DATA, "gbench_sample.json"))
         self.assertEqual(r.kind, "gbench")
