@@ -7,7 +7,7 @@
 # each a median of µs per particle-step; then the halo traffic (messages and bytes per step per rank,
 # ghosts per rank) of mpi at R = 2 and 4 for every N of --halo-n, measured on the dense bed's lattice
 # (a few steps from t = 0: the counts, not the times, are what is kept); the imbalance of the static
-# slabs on the bed and the compression stage (cut by count and evenly); then the scaling model of
+# bricks on the bed and the compression stage (cut by count and evenly); then the scaling model of
 # docs/scaling.md from these measurements (analysis/mpi_scaling.py). Results in results/mpi/.
 # Usage: scripts/run_mpi_bench.sh [--n "100000"] [--halo-n "10000 100000 1000000"] [--steps K] [--repetitions R]
 #                                 [--settle-time T] [--imbalance-steps K] [--out DIR] [--build-dir DIR]
@@ -107,8 +107,8 @@ for n in $halo_ns; do
   done
 done
 
-# Imbalance of the static slabs: the settled bed and the compression stage (the x_max wall moving in at
-# 0.5 m/s, the slabs along x: the slab by the wall empties), cut by count and evenly, at R = 2 and 4;
+# Imbalance of the static bricks: the settled bed and the compression stage (the x_max wall moving in at
+# 0.5 m/s: the bricks by the wall empty), cut by count and evenly, at R = 2 and 4 (the planner's grids);
 # the counts per rank, not the times, are what is kept (R = 4 shares the cores).
 for n in $ns; do
   d=$work/n$n
