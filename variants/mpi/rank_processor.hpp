@@ -106,7 +106,7 @@ public:
         p_ = RankParticles{};
         p_.add_migrants(comm_.scatter(parts));
         for (std::size_t l = 0; l < p_.owned(); ++l) p_.f[l] = p_.t[l] = Vec3d{};
-        if constexpr (M::memory) load_stretches(s);
+        if constexpr (M::memory) st_.load(comm_, plan_.bricks, s, walls_.size(), p_);
         owned_max_ = std::int64_t(p_.owned());
         steps_ = 0;
         migrants_ = 0;
@@ -331,7 +331,7 @@ public:
                 q += 3;
             }
         }
-        if constexpr (M::memory) save_stretches(out);
+        if constexpr (M::memory) st_.save(comm_, list_.pairs, live_, p_, out);
     }
 
     bool supports(const ContactModel&) const override { return true; }
@@ -395,61 +395,6 @@ private:
                 if (live_[k]) st_.pending[{p_.id[std::size_t(list_.pairs[k].i)], p_.id[std::size_t(list_.pairs[k].j)]}] = st_.pair[k];
         p_.drop_ghosts();
         migrants_ += halo_.migrate(comm_, p_, M::memory ? &st_ : nullptr);
-    }
-
-    // Rank 0's state's stretches, to the ranks that own a contact's particles (both, for a pair that
-    // straddles a face); the pairs wait in `pending` for the first rebuild.
-    void load_stretches(const State& s)
-    {
-        st_.walls = walls_.size();
-        st_.resize_owned(p_.owned());
-        std::vector<std::vector<double>> parts;
-        if (comm_.root()) {
-            parts.resize(std::size_t(comm_.size()));
-            auto owner = [&](std::int64_t i) { return plan_.bricks.owner(s.trans.x[std::size_t(i)]); };
-            for (const ContactStretch& c : s.stretches) {
-                const Stretch<double> v{c.tangential, c.rolling};
-                const int oi = owner(c.i);
-                pack_stretch(parts[std::size_t(oi)], c.i, c.wall ? -1 - c.partner : c.partner, v);
-                if (!c.wall && owner(c.partner) != oi) pack_stretch(parts[std::size_t(owner(c.partner))], c.i, c.partner, v);
-            }
-        }
-        const std::vector<double> mine = comm_.scatter(parts);
-        std::unordered_map<std::int64_t, std::size_t> local;
-        for (std::size_t l = 0; l < p_.owned(); ++l) local[p_.id[l]] = l;
-        for (std::size_t at = 0; at + kStretchDoubles <= mine.size(); at += kStretchDoubles) {
-            const double* q = &mine[at];
-            const std::int64_t i = double_to_id(q[0]), j = double_to_id(q[1]);
-            if (j < 0) {
-                const std::size_t w = std::size_t(-1 - j), l = local.at(i);
-                st_.wall_row(l)[w] = unpack_stretch(q);
-                st_.wall_live[l * walls_.size() + w] = 1;
-            } else {
-                st_.pending[{i, j}] = unpack_stretch(q);
-            }
-        }
-    }
-
-    // Every live contact's stretch once (a pair where its lower id is owned, a wall contact of an owned
-    // particle), gathered on rank 0 in the canonical order.
-    void save_stretches(State& out) const
-    {
-        std::vector<double> mine;
-        const std::size_t no = p_.owned();
-        for (std::size_t k = 0; k < list_.pairs.size() && k < live_.size(); ++k)
-            if (live_[k] && std::size_t(list_.pairs[k].i) < no)
-                pack_stretch(mine, p_.id[std::size_t(list_.pairs[k].i)], p_.id[std::size_t(list_.pairs[k].j)], st_.pair[k]);
-        for (std::size_t l = 0; l < no; ++l)
-            for (std::size_t w = 0; w < walls_.size(); ++w)
-                if (st_.wall_live[l * walls_.size() + w]) pack_stretch(mine, p_.id[l], -1 - std::int64_t(w), st_.wall[l * walls_.size() + w]);
-        const std::vector<double> all = comm_.gather(mine);
-        for (std::size_t at = 0; at + kStretchDoubles <= all.size(); at += kStretchDoubles) {
-            const double* q = &all[at];
-            const std::int64_t i = double_to_id(q[0]), j = double_to_id(q[1]);
-            const Stretch<double> v = unpack_stretch(q);
-            out.stretches.push_back({i, j < 0 ? -1 - j : j, j < 0, v.t, v.r});
-        }
-        std::sort(out.stretches.begin(), out.stretches.end());
     }
 
     // The owned particles into fast's cell order (soa/cell_order.hpp), so that the list's pairs, the

@@ -6,11 +6,14 @@
 // (lower id, higher id); a migrant takes along its walls' row and the stretches of its pairs, which the
 // rank it joins needs for the pairs with particles it did not hold (a pair that straddles a face is held,
 // and updated from the same inputs, by both ranks).
+#include <algorithm>
 #include <cstdint>
 #include <unordered_map>
 #include <vector>
 
+#include "bricks.hpp"
 #include "comm.hpp"
+#include "rank_particles.hpp"
 #include "demmat/contact_memory.hpp"
 #include "demmat/state.hpp"
 
@@ -83,6 +86,64 @@ struct RankStretches {
             wall_live[l * walls + w] = p[0] != 0.0;
             wall[l * walls + w] = {{p[1], p[2], p[3]}, {p[4], p[5], p[6]}};
         }
+    }
+
+    // Rank 0's state's stretches (collective), to the ranks that own a contact's particles (both, for a
+    // pair that straddles a face): a wall contact into its owned particle's row, a pair into `pending`
+    // for the first rebuild. `p` holds this rank's owned particles, no ghosts yet.
+    void load(const Comm& comm, const Bricks& bricks, const State& s, std::size_t wall_count, const RankParticles& p)
+    {
+        walls = wall_count;
+        resize_owned(p.owned());
+        std::vector<std::vector<double>> parts;
+        if (comm.root()) {
+            parts.resize(std::size_t(comm.size()));
+            auto owner = [&](std::int64_t i) { return bricks.owner(s.trans.x[std::size_t(i)]); };
+            for (const ContactStretch& c : s.stretches) {
+                const Stretch<double> v{c.tangential, c.rolling};
+                const int oi = owner(c.i);
+                pack_stretch(parts[std::size_t(oi)], c.i, c.wall ? -1 - c.partner : c.partner, v);
+                if (!c.wall && owner(c.partner) != oi) pack_stretch(parts[std::size_t(owner(c.partner))], c.i, c.partner, v);
+            }
+        }
+        const std::vector<double> mine = comm.scatter(parts);
+        std::unordered_map<std::int64_t, std::size_t> local;
+        for (std::size_t l = 0; l < p.owned(); ++l) local[p.id[l]] = l;
+        for (std::size_t at = 0; at + kStretchDoubles <= mine.size(); at += kStretchDoubles) {
+            const double* q = &mine[at];
+            const std::int64_t i = double_to_id(q[0]), j = double_to_id(q[1]);
+            if (j < 0) {
+                const std::size_t w = std::size_t(-1 - j), l = local.at(i);
+                wall_row(l)[w] = unpack_stretch(q);
+                wall_live[l * walls + w] = 1;
+            } else {
+                pending[{i, j}] = unpack_stretch(q);
+            }
+        }
+    }
+
+    // Every live contact's stretch once (collective): a listed pair (`pairs`, local indices, i the lower
+    // id; `live` from the last force pass) whose i is owned, a wall contact of an owned particle;
+    // gathered into rank 0's `out` in the canonical order.
+    template <class Pair>
+    void save(const Comm& comm, const std::vector<Pair>& pairs, const std::vector<char>& live, const RankParticles& p, State& out) const
+    {
+        std::vector<double> mine;
+        const std::size_t no = p.owned();
+        for (std::size_t k = 0; k < pairs.size() && k < live.size(); ++k)
+            if (live[k] && std::size_t(pairs[k].i) < no)
+                pack_stretch(mine, p.id[std::size_t(pairs[k].i)], p.id[std::size_t(pairs[k].j)], pair[k]);
+        for (std::size_t l = 0; l < no; ++l)
+            for (std::size_t w = 0; w < walls; ++w)
+                if (wall_live[l * walls + w]) pack_stretch(mine, p.id[l], -1 - std::int64_t(w), wall[l * walls + w]);
+        const std::vector<double> all = comm.gather(mine);
+        for (std::size_t at = 0; at + kStretchDoubles <= all.size(); at += kStretchDoubles) {
+            const double* q = &all[at];
+            const std::int64_t i = double_to_id(q[0]), j = double_to_id(q[1]);
+            const Stretch<double> v = unpack_stretch(q);
+            out.stretches.push_back({i, j < 0 ? -1 - j : j, j < 0, v.t, v.r});
+        }
+        std::sort(out.stretches.begin(), out.stretches.end());
     }
 
     std::size_t memory_bytes() const
