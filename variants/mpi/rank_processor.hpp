@@ -15,10 +15,10 @@
 //            (position, velocity, angular velocity of the same particles, in the same order). A particle
 //            moves less than half the skin between rebuilds, so the list holds every contact (the law
 //            decides)
-//   forces   each pair's force once per rank, by the shared law with the lower id as i: under the
-//            paper's law by the shared pair kernel on lanes (rank_pair_kernel.hpp, fast's kernel), a
-//            block of owned particles' pairs into a ring of slots and then the block's sums, four at a
-//            time (rank_sum_table.hpp); under a law of physics.md §9 by the scalar law. Each owned
+//   forces   each pair's force once per rank, by the shared law with the lower id as i: by the
+//            shared pair kernel on lanes (rank_pair_kernel.hpp, fast's kernel, the laws of physics.md §9
+//            with their stretches included), a block of owned particles' pairs into a ring of slots
+//            and then the block's sums, four at a time (rank_sum_table.hpp). Each owned
 //            particle's sum in the canonical order (partners ascending by id, then walls in order).
 //            The owned particles are in cell order from each rebuild (sort_owned), for locality
 //   correct  marks the Gear corrector pending: the next predict's pass applies it, snapshot and save
@@ -86,7 +86,7 @@ public:
             mono_pp_ = pair_coefficients(plan_.r0, plan_.r0, plan_.m0, plan_.m0, params_);
             mono_pw_ = wall_coefficients(plan_.r0, plan_.m0, params_);
         }
-        if constexpr (!law) kernel_.init(params_, mono_pp_);
+        kernel_.init(params_, mono_pp_, memory_);
         // Rank 0 holds the whole state: each rank receives its brick's particles as migrants.
         std::vector<std::vector<double>> parts;
         if (comm_.root()) {
@@ -133,14 +133,7 @@ public:
             sort_owned();
             halo_.exchange_ghosts(comm_, p_);
             find_pairs();
-            if constexpr (M::memory) {  // each new pair takes its stretch by key; the others start at zero
-                st_.pair.assign(list_.pairs.size(), Stretch<double>{});
-                for (std::size_t k = 0; k < list_.pairs.size(); ++k) {
-                    const auto it = st_.pending.find({p_.id[std::size_t(list_.pairs[k].i)], p_.id[std::size_t(list_.pairs[k].j)]});
-                    if (it != st_.pending.end()) st_.pair[k] = it->second;
-                }
-                st_.pending.clear();
-            }
+            if constexpr (M::memory) st_.pending.clear();
             x_built_.assign(p_.x.begin(), p_.x.begin() + std::ptrdiff_t(p_.owned()));
             built_ = true;
             ++rebuilds_;
@@ -156,22 +149,17 @@ public:
     {
         pw_ = 0;
         const std::size_t no = p_.owned();
-        if constexpr (law) {
-            law_pairs();
-            sum_owned(0, no);
-        } else {
-            // The pairs whose lower id is a ghost's first (few, at the faces), then block by block the
-            // pairs found at a block's particles and the block's sums, while its slots are in cache.
-            kernel_.refresh_records(p_);
-            kernel_.run_ghost_pairs();
-            pp_ = 0;
-            for (std::size_t a = 0; a < no; a += kSumBlock) {
-                const std::size_t b = std::min(no, a + kSumBlock);
-                pp_ += kernel_.run(list_.found_at[a], list_.found_at[b]);
-                sum_owned(a, b);
-            }
-            candidates_ = std::int64_t(list_.counted);
+        // The pairs whose lower id is a ghost's first (few, at the faces), then block by block the pairs
+        // found at a block's particles and the block's sums, while its slots are in cache.
+        kernel_.refresh_records(p_);
+        kernel_.run_ghost_pairs();
+        pp_ = 0;
+        for (std::size_t a = 0; a < no; a += kSumBlock) {
+            const std::size_t b = std::min(no, a + kSumBlock);
+            pp_ += kernel_.run(list_.found_at[a], list_.found_at[b]);
+            sum_owned(a, b);
         }
+        candidates_ = std::int64_t(list_.counted);
     }
 
     // Owned particles [a, b): each one's sum in the canonical order (its pairs as j, as i, then its
@@ -182,10 +170,7 @@ public:
         for (std::size_t l0 = a; l0 < b; l0 += kSumGroup) {
             const std::size_t n = std::min(kSumGroup, b - l0);
             Vec3d fs[kSumGroup]{}, ts[kSumGroup]{};
-            if constexpr (law)
-                for (std::size_t g = 0; g < n; ++g) law_pair_sum(l0 + g, fs[g], ts[g]);
-            else
-                slot_sums(l0, fs, ts);
+            slot_sums(l0, fs, ts);
             for (std::size_t g = 0; g < n; ++g) {
                 const std::size_t l = l0 + g;
                 Vec3d f = fs[g], t = ts[g];
@@ -263,24 +248,6 @@ public:
             }
     }
 
-    // Under a law of physics.md §9: owned particle l's pair terms, the live pairs only.
-    void law_pair_sum(std::size_t l, Vec3d& f, Vec3d& t) const
-    {
-        const std::int32_t* rows = list_.rows.data();
-        for (std::size_t e = list_.row_start[l]; e < list_.row_mid[l]; ++e) {
-            const std::size_t k = std::size_t(rows[e]);
-            if (!live_[k]) continue;  // a pair the law rejects adds nothing, not even a zero
-            f = f + (-pf_[k].f_i);
-            if constexpr (M::rotation) t = t + pf_[k].t_j;
-        }
-        for (std::size_t e = list_.row_mid[l]; e < list_.row_start[l + 1]; ++e) {
-            const std::size_t k = std::size_t(rows[e]);
-            if (!live_[k]) continue;
-            f = f + pf_[k].f_i;
-            if constexpr (M::rotation) t = t + pf_[k].t_i;
-        }
-    }
-
     // Pending until the next predict (its pass applies it) or a snapshot or save (they read `corrected`).
     void correct() override { corrector_pending_ = true; }
 
@@ -331,15 +298,23 @@ public:
                 q += 3;
             }
         }
-        if constexpr (M::memory) st_.save(comm_, list_.pairs, live_, p_, out);
+        if constexpr (M::memory) {
+            // The pairs that touched at the last force pass, once: where the lower id is owned.
+            std::vector<double> pairs;
+            for (std::size_t k = 0; k < list_.counted; ++k) {
+                const auto [i, j] = list_.pairs[k];
+                if (kernel_.touched(std::size_t(i), std::size_t(j)))
+                    pack_stretch(pairs, p_.id[std::size_t(i)], p_.id[std::size_t(j)], kernel_.stretch(k));
+            }
+            st_.save(comm_, pairs, p_, out);
+        }
     }
 
     bool supports(const ContactModel&) const override { return true; }
     ContactCounts counts() const override { return {comm_.sum(pp_), comm_.sum(pw_), comm_.sum(candidates_)}; }
     std::size_t memory_bytes() const override
     {
-        return p_.memory_bytes() + st_.memory_bytes() + list_.memory_bytes() + halo_.memory_bytes() + near_.capacity() * sizeof(std::uint64_t) + pf_.capacity() * sizeof(ContactForce<double>) +
-               live_.capacity() + kernel_.memory_bytes() + sums_.memory_bytes() + order_.bytes() + fast::heap_bytes(order_x_, order_id_, order_from_);
+        return p_.memory_bytes() + st_.memory_bytes() + list_.memory_bytes() + halo_.memory_bytes() + near_.capacity() * sizeof(std::uint64_t) + kernel_.memory_bytes() + sums_.memory_bytes() + order_.bytes() + fast::heap_bytes(order_x_, order_id_, order_from_);
     }
     ModelFeatures model() const override { return ModelFeatures::of<M>(); }
 
@@ -358,28 +333,6 @@ private:
     static constexpr std::size_t kSumBlock = 256;  // owned particles per block of forces()
     static constexpr std::size_t kSumGroup = RankSumTable::kGroup;  // sums made side by side (slot_sums)
 
-    // A law of physics.md §9: each listed pair through the scalar law, its stretch in and out.
-    void law_pairs()
-    {
-        const std::size_t np = list_.pairs.size(), no = p_.owned();
-        pf_.resize(np);
-        live_.resize(np);
-        pp_ = 0;
-        candidates_ = 0;
-        for (std::size_t k = 0; k < np; ++k) {
-            const auto [i, j] = list_.pairs[k];
-            Stretch<double> s{};  // none to carry for restitution damping alone
-            if constexpr (M::memory) s = st_.pair[k];
-            live_[k] = particle_contact_memory<M>(p_.x[i], p_.x[j], p_.v[i], p_.v[j], p_.w[i], p_.w[j], p_.r[i], p_.r[j], p_.m[i], p_.m[j],
-                                                  params_, memory_, s, true, pf_[k]);
-            if constexpr (M::memory) st_.pair[k] = live_[k] ? s : Stretch<double>{};
-            if (std::size_t(i) < no) {  // counted where the lower id is owned: once over all ranks
-                ++candidates_;
-                if (live_[k]) ++pp_;
-            }
-        }
-    }
-
     void place_walls(std::int64_t step)
     {
         for (std::size_t w = 0; w < walls_.size(); ++w) wp_[w] = walls_[w].point_at(step, dt_);
@@ -391,8 +344,8 @@ private:
     void migrate()
     {
         if constexpr (M::memory)
-            for (std::size_t k = 0; k < list_.pairs.size() && k < live_.size(); ++k)
-                if (live_[k]) st_.pending[{p_.id[std::size_t(list_.pairs[k].i)], p_.id[std::size_t(list_.pairs[k].j)]}] = st_.pair[k];
+            for (std::size_t k = 0; k < list_.pairs.size(); ++k)
+                if (kernel_.carries(k)) st_.pending[{p_.id[std::size_t(list_.pairs[k].i)], p_.id[std::size_t(list_.pairs[k].j)]}] = kernel_.stretch(k);
         p_.drop_ghosts();
         migrants_ += halo_.migrate(comm_, p_, M::memory ? &st_ : nullptr);
     }
@@ -421,12 +374,19 @@ private:
     // Each rank's answer comes from its predict pass.
     bool must_rebuild() { return comm_.any(moved_far_); }
 
-    // The rank's neighbour list (rank_list.hpp), and under the paper's law the kernel's slots.
+    // The rank's neighbour list (rank_list.hpp), the kernel's slots (each pair with the stretch it
+    // carries, by key), and the sums' table.
     void find_pairs()
     {
         list_.build(p_, plan_.cell, plan_.skin, kSumBlock);
-        if constexpr (!law) {
-            kernel_.set_pairs(list_.pairs, list_.counted, list_.reach);
+        {
+            kernel_.set_pairs(list_.pairs, list_.counted, list_.reach, p_, [&](std::int64_t i, std::int64_t j) -> const Stretch<double>* {
+                if constexpr (M::memory) {
+                    const auto it = st_.pending.find({i, j});
+                    return it == st_.pending.end() ? nullptr : &it->second;
+                }
+                return nullptr;
+            });
             sums_.build(list_, p_.owned(), [&](std::size_t k) { return kernel_.position(k); }, kernel_.zero_position());
         }
     }
@@ -456,11 +416,9 @@ private:
     RankHalo halo_;  // the exchanges with the bricks around
     RankList list_;
     std::vector<std::uint64_t> near_;  // find_walls: a bit per wall that each owned particle may touch
-    std::vector<ContactForce<double>> pf_;
-    std::vector<char> live_;
     std::int64_t pp_ = 0, pw_ = 0, candidates_ = 0;
-    RankPairKernel<M> kernel_;        // the paper's law: the pairs on lanes
-    RankSumTable sums_;               // the paper's law: the slots each group of sums reads
+    RankPairKernel<M> kernel_;        // the pairs on lanes, and under a law with memory their stretches
+    RankSumTable sums_;               // the slots each group of sums reads
     fast::CellOrder order_;           // sort_owned's scratch
     std::vector<double> order_x_;
     std::vector<fast::Index> order_id_;

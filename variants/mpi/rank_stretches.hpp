@@ -1,7 +1,7 @@
 #pragma once
-// One rank's contact memory under a law of physics.md §9 (contact_memory.hpp): the stretch of each
-// listed pair (a slot per pair of the neighbour list, zero unless the pair was in contact at the last
-// force evaluation) and of each owned particle's contact with each wall (a row of one slot per wall).
+// One rank's contact memory under a law of physics.md §9 (contact_memory.hpp) besides the pairs' (the
+// pair kernel keeps a listed pair's stretch in its record, rank_pair_kernel.hpp): each owned particle's
+// contact with each wall (a row of one slot per wall), and the pairs' stretches across a rebuild.
 // Keys are ids, never slots: across a rebuild the pairs' stretches pass through a map keyed by the pair
 // (lower id, higher id); a migrant takes along its walls' row and the stretches of its pairs, which the
 // rank it joins needs for the pairs with particles it did not hold (a pair that straddles a face is held,
@@ -41,7 +41,6 @@ inline Stretch<double> unpack_stretch(const double* p) { return {{p[2], p[3], p[
 
 struct RankStretches {
     std::size_t walls = 0;
-    std::vector<Stretch<double>> pair;             // per pair of the list
     std::vector<Stretch<double>> wall;             // (owned, walls)
     std::vector<char> wall_live;                   // (owned, walls): in contact at the last evaluation
     std::unordered_map<PairKey, Stretch<double>, PairKeyHash> pending;  // pairs' stretches across a rebuild
@@ -122,17 +121,13 @@ struct RankStretches {
         }
     }
 
-    // Every live contact's stretch once (collective): a listed pair (`pairs`, local indices, i the lower
-    // id; `live` from the last force pass) whose i is owned, a wall contact of an owned particle;
-    // gathered into rank 0's `out` in the canonical order.
-    template <class Pair>
-    void save(const Comm& comm, const std::vector<Pair>& pairs, const std::vector<char>& live, const RankParticles& p, State& out) const
+    // Every live contact's stretch once (collective): `pairs`, the rank's packed pair contacts (each once
+    // over the ranks), and the wall contacts of its owned particles, gathered into rank 0's `out` in the
+    // canonical order.
+    void save(const Comm& comm, std::vector<double> pairs, const RankParticles& p, State& out) const
     {
-        std::vector<double> mine;
+        std::vector<double>& mine = pairs;
         const std::size_t no = p.owned();
-        for (std::size_t k = 0; k < pairs.size() && k < live.size(); ++k)
-            if (live[k] && std::size_t(pairs[k].i) < no)
-                pack_stretch(mine, p.id[std::size_t(pairs[k].i)], p.id[std::size_t(pairs[k].j)], pair[k]);
         for (std::size_t l = 0; l < no; ++l)
             for (std::size_t w = 0; w < walls; ++w)
                 if (wall_live[l * walls + w]) pack_stretch(mine, p.id[l], -1 - std::int64_t(w), wall[l * walls + w]);
@@ -148,7 +143,7 @@ struct RankStretches {
 
     std::size_t memory_bytes() const
     {
-        return (pair.capacity() + wall.capacity()) * sizeof(Stretch<double>) + wall_live.capacity() +
+        return wall.capacity() * sizeof(Stretch<double>) + wall_live.capacity() +
                pending.size() * (sizeof(PairKey) + sizeof(Stretch<double>) + 2 * sizeof(void*));
     }
 };
