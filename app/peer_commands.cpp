@@ -14,6 +14,7 @@
 #include "demmat/io.hpp"
 #include "demmat/peer_io.hpp"
 #include "demmat/registry.hpp"
+#include "demmat/stability.hpp"
 #include "cli_ranges.hpp"
 
 namespace fs = std::filesystem;
@@ -28,6 +29,7 @@ struct PeerCommands::Args {
     double perturb = 0.0, skin = 0.0;
     std::uint64_t seed = 1;
     std::int64_t steps = 1000, every = 100;
+    bool allow_unstable = false;
 };
 
 PeerCommands::PeerCommands(CLI::App& app) : a_(std::make_unique<Args>())
@@ -57,6 +59,7 @@ PeerCommands::PeerCommands(CLI::App& app) : a_(std::make_unique<Args>())
                                            "scene's step, continued from a state file's)")->check(integer_in(1, kMaxSteps));
     a.dump->add_option("--integrator", a.integrator, "gear5 | gear3 | verlet | symplectic_euler (overrides the scene's [integrator])");
     a.dump->add_option("--out,-o", a.out, "Dump file to write")->required();
+    a.dump->add_flag("--allow-unstable", a.allow_unstable, "Run even with a time step above the integrator's stability limit, without warning");
 }
 
 PeerCommands::~PeerCommands() = default;
@@ -121,7 +124,7 @@ int cmd_import(const std::string& file, const std::string& scene_file, const std
 }
 
 int cmd_dump(const std::string& scene_file, const std::string& state_file, const std::string& variant_name, const std::string& integrator,
-             std::int64_t steps, std::int64_t every, const std::string& out)
+             std::int64_t steps, std::int64_t every, const std::string& out, bool allow_unstable)
 {
     Scene scene = load_scene(scene_file);
     override_integrator(scene, integrator, {});
@@ -129,6 +132,10 @@ int cmd_dump(const std::string& scene_file, const std::string& state_file, const
     check_output_path(out, "--out", inputs_of(scene));
     check_output_path(out + ".part", "--out", inputs_of(scene));
     const State state = initial_state(scene);
+    if (!allow_unstable) {  // the time step against the chosen integrator's limit, as run checks it
+        const std::string warning = check_time_step(scene, state);
+        if (!warning.empty()) std::cerr << "demmat: warning: " << warning << "\n";
+    }
     const Setup setup = Setup::make(scene, state);
     auto variant = registry().find(variant_name).create();
     Driver driver(*variant, setup);
@@ -173,7 +180,7 @@ int PeerCommands::dispatch()
     const Args& a = *a_;
     if (*a.exp) return cmd_export(a.scene, a.state, a.out, a.perturb, a.seed, a.skin);
     if (*a.imp) return cmd_import(a.state, a.scene, a.out);
-    if (*a.dump) return cmd_dump(a.scene, a.state, a.variant, a.integrator, a.steps, a.every, a.out);
+    if (*a.dump) return cmd_dump(a.scene, a.state, a.variant, a.integrator, a.steps, a.every, a.out, a.allow_unstable);
     return -1;
 }
 

@@ -158,6 +158,18 @@ execute_process(COMMAND ${DEMMAT} dump ${WORK}/peer/head_on.toml --variant oop -
 if(NOT rc EQUAL 2 OR EXISTS ${WORK}/peer/oop_verlet.dump OR EXISTS ${WORK}/peer/oop_verlet.dump.part)
   message(FATAL_ERROR "dump --variant oop --integrator verlet: exit ${rc} (expected 2, nothing written): ${err}")
 endif()
+# dump checks the time step against the integrator it runs, as run does: Δt = 1e-4 s is within gear5's
+# limit for the head-on pair, not symplectic Euler's; --allow-unstable runs it anyway.
+file(READ ${WORK}/peer/head_on.toml head_on)
+string(REGEX REPLACE "\ndt = [^\n]*" "\ndt = 1e-4" head_on "${head_on}")
+file(WRITE ${WORK}/peer/head_on_dt.toml "${head_on}")
+run_ok(dump ${WORK}/peer/head_on_dt.toml --steps 4 -o ${WORK}/peer/dt_gear5.dump)
+execute_process(COMMAND ${DEMMAT} dump ${WORK}/peer/head_on_dt.toml --integrator symplectic_euler --steps 4 -o ${WORK}/peer/dt_euler.dump
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "symplectic_euler stability limit" OR EXISTS ${WORK}/peer/dt_euler.dump)
+  message(FATAL_ERROR "dump --integrator symplectic_euler above its limit: exit ${rc} (expected 2, nothing written): ${err}")
+endif()
+run_ok(dump ${WORK}/peer/head_on_dt.toml --integrator symplectic_euler --allow-unstable --steps 4 -o ${WORK}/peer/dt_euler.dump)
 # The last frame of that dump, imported, is at step 54: a dump from it starts there.
 run_ok(import-lammps ${WORK}/peer/run.dump --scene ${WORK}/comp.toml -o ${WORK}/peer/from_dump.state)
 run_ok(dump ${WORK}/comp.toml --state ${WORK}/peer/from_dump.state --steps 1 --every 1 -o ${WORK}/peer/again.dump)
