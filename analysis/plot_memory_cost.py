@@ -1,6 +1,7 @@
 #!/usr/bin/python3
 """What contact memory costs each style: µs per particle-step and bytes per particle per variant × law ×
-stage, from the `demmat bench` files that scripts/run_memory_cost.sh lists in its runs.tsv (law, stage,
+stage, from the `demmat bench` files (and `demmat_mpi bench` files: the mpi variant, its processes in the
+threads column) that scripts/run_memory_cost.sh lists in its runs.tsv (law, stage,
 round, file: the law and stage come from the manifest, never from a file or scene name).
 
 µs per particle-step is the median over the rounds of each bench run's step time (the four phases
@@ -38,6 +39,12 @@ def samples(manifest):
         res = load(os.path.join(folder, run.file))
         provenance, meta = provenance or res.provenance, meta or res.meta
         n = res.meta["scene"]["particles"]
+        if res.kind == "mpi":  # demmat_mpi bench --json: one configuration, its median step over the repetitions
+            m = res.meta
+            rows.append({"law": run.law, "stage": run.stage, "round": run.round, "variant": "mpi", "threads": int(m["processes"]),
+                         "N": n, "us_per_particle_step": m["us_per_particle_step"], "bytes_per_particle": m["memory_bytes"] / n,
+                         "contacts_per_particle": m["contacts_per_particle"], "model": m["model"]})
+            continue
         w = wide(res.table)
         summary = {(s["variant"], s["threads_asked"]): s for s in res.meta["summary"]}
         for s in w.itertuples():

@@ -193,6 +193,7 @@ int cmd_bench(const Comm& comm, const Args& a)
         if (comm.root()) samples.push_back(report_json(reps.back(), *v));
         last = std::move(v);
     }
+    const std::int64_t bytes = comm.sum(std::int64_t(last->memory_bytes()));  // every rank's, as Variant::memory_bytes
     if (!comm.root()) return 0;
     const RunReport med = median_report(reps);
     const double n = double(p->size());
@@ -210,6 +211,7 @@ int cmd_bench(const Comm& comm, const Args& a)
                   {"repetitions", a.repetitions},
                   {"us_per_particle_step", med.total() / n * 1e6},
                   {"contacts_per_particle", c.per_particle(p->size())},
+                  {"memory_bytes", bytes},
                   {"median", report_json(med, *last)},
                   {"samples", samples}};
         write_atomically(a.json_file, j.dump(2) + "\n");

@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # What contact memory costs each style: µs per particle-step and bytes per particle of every registered
-# variant that runs the law, under the paper's law, linear_history, mindlin and mindlin + sds (physics.md
+# variant that runs the law and of the mpi variant at one process (where Open MPI is here), under the paper's law, linear_history, mindlin and mindlin + sds (physics.md
 # §9), on the settled dense bed and on the compression stage. Each law's bed is settled once with fast
 # (a state carries its law in its fingerprint, so each law settles its own); then R rounds, each timing
 # every (law, stage) with `demmat bench` (the variants interleaved inside it, one repetition), the
@@ -51,6 +51,18 @@ contact_args() {
 
 cmake_build -q "$BUILD_DIR" demmat
 demmat=$(demmat_in "$BUILD_DIR")
+# The mpi variant (not in the registry) at one process, where Open MPI is here: its own style of keeping
+# the stretches, without the exchanges. Left out, with a line, where demmat_mpi does not build.
+demmat_mpi=
+if [[ $variants == all || ,$variants, == *,mpi,* ]]; then
+  if cmake --build "$BUILD_DIR" -j "$JOBS" --target demmat_mpi >/dev/null 2>&1; then
+    demmat_mpi=${demmat%/demmat}/demmat_mpi
+    export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
+  else
+    echo "$SCRIPT: the mpi variant is left out: demmat_mpi does not build here (Open MPI: scripts/install_deps.sh)" >&2
+  fi
+  variants=${variants//mpi/}; variants=${variants//,,/,}; variants=${variants#,}; variants=${variants%,}; [[ -n $variants ]] || variants=all
+fi
 work=scenes/generated/memory_cost_$n
 mkdir -p "$work" states "$out"
 tmp=$(mktemp -d); trap 'rm -rf "$tmp"' EXIT
@@ -101,6 +113,12 @@ for ((r = 0; r < reps; r++)); do
     $demmat bench "$scene" --variants "${runs_law[$law]}" --steps "$steps" --repetitions 1 --threads "$threads" \
       --json "$out/$file" >/dev/null 2>"$tmp/bench.log" || { cat "$tmp/bench.log" >&2; exit 1; }
     printf '%s\t%s\t%d\t%s\n' "$law" "$stage" $((r + 1)) "$file" >>"$tmp/runs.tsv"
+    if [[ -n $demmat_mpi ]]; then
+      file=bench_mpi_${law}_${stage}_r$((r + 1)).json
+      mpirun --bind-to core -np 1 "$demmat_mpi" bench "$scene" --steps "$steps" --repetitions 1 --json "$out/$file" >/dev/null 2>"$tmp/bench.log" \
+        || { cat "$tmp/bench.log" >&2; exit 1; }
+      printf '%s\t%s\t%d\t%s\n' "$law" "$stage" $((r + 1)) "$file" >>"$tmp/runs.tsv"
+    fi
   done
   echo "== round $((r + 1))/$reps done"
 done
