@@ -54,15 +54,25 @@ class Loader(unittest.TestCase):
         self.assertTrue((per_rank.ghosts > 0).all())
         self.assertTrue((per_rank.messages_per_step >= 1).all())  # one refresh to the neighbour per step, at least
 
-    def test_two_configurations_on_the_same_threads_stay_two_samples(self):
-        # fast asked for 1 and 2 threads on a small bed runs on 1 both times: still two samples each
-        import json, tempfile
+    @staticmethod
+    def fast_asked_for_1_and_2_threads_ran_on_1():
+        """The bench sample as if fast, asked for 1 and 2 threads on a small bed, ran on 1 both times."""
+        import json
         raw = json.load(open(os.path.join(DATA, "bench_sample.json")))
         extra = [dict(x, threads=1, threads_asked=1) for x in raw["samples"] if x["variant"] == "fast"]
         for x in raw["samples"]:
             if x["variant"] == "fast":
                 x["threads"], x["threads_asked"] = 1, 2
         raw["samples"] += extra
+        fast = next(s for s in raw["summary"] if s["variant"] == "fast")
+        raw["summary"].append(dict(fast, threads=1, threads_asked=1))
+        fast.update(threads=1, threads_asked=2)
+        return raw
+
+    def test_two_configurations_on_the_same_threads_stay_two_samples(self):
+        # fast asked for 1 and 2 threads on a small bed runs on 1 both times: still two samples each
+        import json, tempfile
+        raw = self.fast_asked_for_1_and_2_threads_ran_on_1()
         with tempfile.NamedTemporaryFile("w", suffix=".json", delete=False) as f:
             json.dump(raw, f)
         r = results.load(f.name)
@@ -75,15 +85,7 @@ class Loader(unittest.TestCase):
     def test_summarise_fast_keys_rows_by_the_threads_asked(self):
         # fast asked for 1 and 2 threads on a small bed runs on 1 both times: two rows, the second saying so
         import json
-        raw = json.load(open(os.path.join(DATA, "bench_sample.json")))
-        extra = [dict(x, threads=1, threads_asked=1) for x in raw["samples"] if x["variant"] == "fast"]
-        for x in raw["samples"]:
-            if x["variant"] == "fast":
-                x["threads"], x["threads_asked"] = 1, 2
-        raw["samples"] += extra
-        fast = next(s for s in raw["summary"] if s["variant"] == "fast")
-        raw["summary"].append(dict(fast, threads=1, threads_asked=1))
-        fast.update(threads=1, threads_asked=2)
+        raw = self.fast_asked_for_1_and_2_threads_ran_on_1()
         work = tempfile.mkdtemp()
         try:
             with open(os.path.join(work, "bench_settled_2000.json"), "w") as f:
