@@ -43,7 +43,7 @@ if [[ $which != sanitize ]]; then
   run_build "$BUILD_DIR"
 fi
 if [[ $which != normal ]]; then
-  # RelWithDebInfo: optimised as the real runs are, with line numbers in the reports.
+  # RelWithDebInfo, which DEMMAT_SANITIZE turns into -O1 -g1 (CMakeLists.txt): line numbers in the reports.
   run_build "$asan_dir" -DDEMMAT_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDEMMAT_BUILD_BENCH=OFF
 fi
 if [[ $which == both ]]; then
