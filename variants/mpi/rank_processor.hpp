@@ -379,16 +379,14 @@ private:
     void find_pairs()
     {
         list_.build(p_, plan_.cell, plan_.skin, kSumBlock);
-        {
-            kernel_.set_pairs(list_.pairs, list_.counted, list_.reach, p_, [&](std::int64_t i, std::int64_t j) -> const Stretch<double>* {
-                if constexpr (M::memory) {
-                    const auto it = st_.pending.find({i, j});
-                    return it == st_.pending.end() ? nullptr : &it->second;
-                }
-                return nullptr;
-            });
-            sums_.build(list_, p_.owned(), [&](std::size_t k) { return kernel_.position(k); }, kernel_.zero_position());
-        }
+        kernel_.set_pairs(list_.pairs, list_.counted, list_.reach, p_, [&](std::int64_t i, std::int64_t j) -> const Stretch<double>* {
+            if constexpr (M::memory) {
+                const auto it = st_.pending.find({i, j});
+                return it == st_.pending.end() ? nullptr : &it->second;
+            }
+            return nullptr;
+        });
+        sums_.build(list_, p_.owned(), [&](std::size_t k) { return kernel_.position(k); }, kernel_.zero_position());
     }
 
     // The walls each owned particle may touch, in wall order.
