@@ -229,7 +229,7 @@ private:
         p_.permute([this](std::size_t s) { return std::size_t(cells_.key(s).from); }, [this](std::size_t s) { return cells_.key(s).id; },
                    par_);
         list_.build(p_, cells_, skin_, opt_.canonical, par_);
-        if (opt_.canonical) sums_.plan(list_, n);
+        if (opt_.canonical) sums_.plan(list_, n, par_);
         if constexpr (kMemory) {
             stretches_.apply(list_, p_.id, n, par_);
             if (!fresh_) stretches_.release_carry();  // while fresh, the next rebuild reads the state's again

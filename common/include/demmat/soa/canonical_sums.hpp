@@ -18,6 +18,7 @@
 #include "neighbour_list.hpp"
 #include "pair_kernel.hpp"
 #include "particles.hpp"
+#include "team.hpp"
 #include "wall_contacts.hpp"
 
 namespace demmat::fast {
@@ -36,19 +37,28 @@ public:
     static constexpr int kGroup = 4;            // particles per sum group (sum_group)
 
     // A group of sums (sum_group): its particles (-1: none), the longest of their lists as j and as i,
-    // and where its table starts in table_.
+    // and where its table starts in its schedule's table.
     struct Group {
         Index grain[kGroup] = {};
         std::int32_t count = 0, as_j = 0, as_i = 0;
         std::uint32_t table = 0;
     };
 
-    // Per particle, the chunks of its slots' first and last owners; the particles by their last chunk
-    // (by_last, from last_start[chunk]) and by their first.
-    std::vector<Index> first_chunk, last_chunk, last_start, by_last, first_start, by_first;
-    // Each chunk's groups, of the two schedules (by last chunk, by first), from group_*_start[chunk].
-    std::vector<Group> groups_last, groups_first;
-    std::vector<Index> group_last_start, group_first_start;
+    // One of the sweep's two schedules (by each particle's last chunk, or by its first): the particles
+    // by chunk (order, from start[chunk]), each chunk's groups (from group_start[chunk]) and their
+    // tables of ring offsets (build_groups).
+    struct Schedule {
+        std::vector<Index> start, order, group_start;
+        std::vector<Group> groups;
+        std::vector<std::uint32_t> table;
+        std::size_t bytes() const { return heap_bytes(start, order, group_start, groups, table); }
+    };
+
+    // Per particle, the chunks of its slots' first and last owners.
+    std::vector<Index> first_chunk, last_chunk;
+    // The upward threads' schedule (by last chunk) and the downward threads' (by first chunk, planned
+    // only for a sweep of two threads or more: plan_first()).
+    Schedule by_last, by_first;
     // The most chunks and slots from a particle's first slot to its last (the sweep's reach): a ring of
     // ring_slots slots (a power of two, at least that reach) holds every slot a sum reads.
     std::size_t span_chunks = 0, ring_slots = 1;
@@ -57,14 +67,15 @@ public:
 
     // After a canonical list is built: a particle's sum needs the slots of the chunks from that of the
     // first owner of its slots to that of the last (itself for its own, its partners of lower id for
-    // the others).
-    void plan(const NeighbourList& list, std::size_t n)
+    // the others). The two schedules are planned side by side on a team of two or more (the list is
+    // rebuilt in the timed loop); a team of one plans only the upward one, all that a sweep of one
+    // thread reads.
+    void plan(const NeighbourList& list, std::size_t n, bool parallel)
     {
         const Index* owner = list.owner.data();
         const Index* jstart = list.jstart.data();
         const Index* as_j = list.as_j.data();
         const Index* pstart = list.start.data();
-        const std::size_t nch = chunks(n);
         first_chunk.resize(n);
         last_chunk.resize(n);
         span_chunks = 0;
@@ -88,11 +99,24 @@ public:
         if ((ring_slots + 2) * sizeof(Slot) > std::size_t(UINT32_MAX))
             throw CapacityError(fmt::format("the fast variant's canonical sweep needs a ring of {} slots, more than its 32-bit offsets "
                                             "reach (a particle's partners are {} slots apart in storage)", ring_slots, reach));
-        bucket_sort(last_chunk, nch, last_start, by_last);
-        bucket_sort(first_chunk, nch, first_start, by_first);
-        table_.clear();
-        build_groups(list, by_last, last_start, nch, group_last_start, groups_last);
-        build_groups(list, by_first, first_start, nch, group_first_start, groups_first);
+        first_planned_ = false;
+#pragma omp parallel if (parallel)
+        {
+#pragma omp single nowait
+            schedule(list, last_chunk, by_last, last_bucket_);
+            if (thread_count() > 1) {
+#pragma omp single nowait
+                plan_first(list);
+            }
+        }
+    }
+
+    // The downward threads' schedule, once per list (a sweep of two threads or more asks for it).
+    void plan_first(const NeighbourList& list)
+    {
+        if (first_planned_) return;
+        schedule(list, first_chunk, by_first, first_bucket_);
+        first_planned_ = true;
     }
 
     // Particle s's sum from `from`, its walls added, stored in p's f and t (Newton's law comes in the
@@ -130,13 +154,13 @@ public:
     // The sums of a group of up to kGroup particles of one chunk's schedule, side by side: a chain of
     // additions per particle, all from the ring. One particle's sum alone (sum_particle) is a chain of
     // dependent additions ended by two loop exits whose trip counts no predictor learns; here the chains
-    // overlap and a group has two exits. The group's table (build_groups) holds the ring offsets in the
+    // overlap and a group has two exits. The group's table (schedule()) holds the ring offsets in the
     // canonical order, as j then as i, a row of kGroup a step; a particle's list that ends before the
     // group's longest goes on with the ring's slot of zeros, which adds nothing (the sum starts at +0 and
     // is never -0, and x + ±0 = x for every other x), so each particle's bits are those of sum_particle
     // (the same order, kept there for the sums that read two rings or the list of all slots, which the
     // tables' ring offsets cannot name).
-    void sum_group(const Group& g, const Slot* ring, const WallContacts& walls, Particles& p) const
+    void sum_group(const Schedule& from, const Group& g, const Slot* ring, const WallContacts& walls, Particles& p) const
     {
         const char* base = reinterpret_cast<const char*>(ring);
         const char* ti = base + 3 * sizeof(double);  // where the torques start, for a slot at offset 0
@@ -151,7 +175,7 @@ public:
             std::memcpy(&q, at, sizeof(q));
             sum -= q;
         };
-        const std::uint32_t* row = table_.data() + g.table;
+        const std::uint32_t* row = from.table.data() + g.table;
         Quad f[kGroup]{}, tq[kGroup]{};
         for (std::int32_t e = 0; e < g.as_j; ++e, row += kGroup)
             for (int l = 0; l < kGroup; ++l) {
@@ -172,18 +196,24 @@ public:
 
     std::size_t bytes() const
     {
-        return heap_bytes(first_chunk, last_chunk, last_start, by_last, first_start, by_first, groups_last, groups_first, group_last_start,
-                          group_first_start, table_, bucket_);
+        return heap_bytes(first_chunk, last_chunk, last_bucket_, first_bucket_) + by_last.bytes() + by_first.bytes();
     }
 
 private:
-    // The groups of each chunk's schedule (the particles order[start[c] … start[c + 1]), sorted by their
-    // counts of slots as j, so that a group's lists are near one length), kGroup particles a group, and
-    // their tables in table_: a row of ring offsets a step, the lists as j to the group's longest, then
-    // as i, padded with the offset of the ring's slot of zeros (ring_slots).
-    void build_groups(const NeighbourList& list, const std::vector<Index>& order, const std::vector<Index>& start, std::size_t nch,
-                      std::vector<Index>& group_start, std::vector<Group>& groups)
+    // The schedule of the particles by chunk[s]: each chunk's particles (order[start[c] … start[c + 1]),
+    // sorted by their counts of slots as j, so that a group's lists are near one length), kGroup particles
+    // a group, and their tables: a row of ring offsets a step, the lists as j to the group's longest,
+    // then as i, padded with the offset of the ring's slot of zeros (ring_slots).
+    void schedule(const NeighbourList& list, const std::vector<Index>& chunk, Schedule& out, std::vector<Index>& bucket) const
     {
+        const std::size_t nch = chunks(chunk.size());
+        bucket_sort(chunk, nch, out.start, out.order);
+        const std::vector<Index>& order = out.order;
+        const std::vector<Index>& start = out.start;
+        std::vector<Index>& group_start = out.group_start;
+        std::vector<Group>& groups = out.groups;
+        std::vector<std::uint32_t>& table = out.table;
+        table.clear();
         const Index* jstart = list.jstart.data();
         const Index* as_j = list.as_j.data();
         const Index* pstart = list.start.data();
@@ -193,17 +223,17 @@ private:
         group_start.assign(nch + 1, 0);
         groups.clear();
         for (std::size_t c = 0; c < nch; ++c) {
-            bucket_.assign(order.begin() + start[c], order.begin() + start[c + 1]);
-            std::sort(bucket_.begin(), bucket_.end(), [&](Index a, Index b) {
+            bucket.assign(order.begin() + start[c], order.begin() + start[c + 1]);
+            std::sort(bucket.begin(), bucket.end(), [&](Index a, Index b) {
                 const Index la = jstart[a + 1] - jstart[a], lb = jstart[b + 1] - jstart[b];
                 return la != lb ? la < lb : a < b;
             });
-            for (std::size_t g0 = 0; g0 < bucket_.size(); g0 += kGroup) {
+            for (std::size_t g0 = 0; g0 < bucket.size(); g0 += kGroup) {
                 Group g;
-                g.count = std::int32_t(std::min<std::size_t>(kGroup, bucket_.size() - g0));
-                g.table = std::uint32_t(table_.size());
+                g.count = std::int32_t(std::min<std::size_t>(kGroup, bucket.size() - g0));
+                g.table = std::uint32_t(table.size());
                 for (int l = 0; l < kGroup; ++l) {
-                    const Index s = l < g.count ? bucket_[g0 + std::size_t(l)] : -1;
+                    const Index s = l < g.count ? bucket[g0 + std::size_t(l)] : -1;
                     g.grain[l] = s;
                     if (s < 0) continue;
                     g.as_j = std::max(g.as_j, jstart[s + 1] - jstart[s]);
@@ -212,12 +242,12 @@ private:
                 for (Index e = 0; e < g.as_j; ++e)
                     for (int l = 0; l < kGroup; ++l) {
                         const Index s = g.grain[l];
-                        table_.push_back(s >= 0 && e < jstart[s + 1] - jstart[s] ? offset(as_j[jstart[s] + e]) : zeros);
+                        table.push_back(s >= 0 && e < jstart[s + 1] - jstart[s] ? offset(as_j[jstart[s] + e]) : zeros);
                     }
                 for (Index e = 0; e < g.as_i; ++e)
                     for (int l = 0; l < kGroup; ++l) {
                         const Index s = g.grain[l];
-                        table_.push_back(s >= 0 && e < pstart[s + 1] - pstart[s] ? offset(pstart[s] + e) : zeros);
+                        table.push_back(s >= 0 && e < pstart[s + 1] - pstart[s] ? offset(pstart[s] + e) : zeros);
                     }
                 groups.push_back(g);
             }
@@ -225,8 +255,8 @@ private:
         }
     }
 
-    std::vector<std::uint32_t> table_;  // the groups' tables of ring offsets
-    std::vector<Index> bucket_;         // scratch: one chunk's particles while they are grouped
+    std::vector<Index> last_bucket_, first_bucket_;  // scratch: one chunk's particles while they are grouped
+    bool first_planned_ = false;
 };
 
 } // namespace demmat::fast

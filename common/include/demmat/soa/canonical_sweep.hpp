@@ -30,7 +30,7 @@ public:
     };
 
     template <class M>
-    Counts run(const NeighbourList& list, const CanonicalSums& sums, WallContacts& walls, Particles& p, const LawInputs& law,
+    Counts run(const NeighbourList& list, CanonicalSums& sums, WallContacts& walls, Particles& p, const LawInputs& law,
                Quad* stretches, bool prefetch, bool parallel)
     {
         constexpr std::size_t kChunk = CanonicalSums::kChunk;
@@ -38,8 +38,8 @@ public:
         std::int64_t pp = 0, pw = 0;
         std::size_t team = 1;
         const Index* pstart = list.start.data();
-        const Index* by_last = sums.by_last.data();
-        const Index* last_start = sums.last_start.data();
+        const Index* by_last = sums.by_last.order.data();
+        const Index* last_start = sums.by_last.start.data();
         const Index* first_chunk = sums.first_chunk.data();
         const Index* last_chunk = sums.last_chunk.data();
         const std::size_t chunks = CanonicalSums::chunks(n), span = sums.span_chunks, ring_slots = sums.ring_slots;
@@ -59,6 +59,7 @@ public:
             const bool down = t % 2 == 1;
 #pragma omp single
             {
+                if (nt > 1) sums.plan_first(list);  // the downward threads' schedule
                 cut_pieces(list, pieces, chunks);
                 for (std::size_t q = 0; q < pieces; ++q) claims_[q].reset(piece_chunk_[q], piece_chunk_[q + 1]);
                 if (pieces > 1) all_.resize(list.pairs() + 1);  // + 1: a sum reads a quad from the last slot's t_j
@@ -81,10 +82,9 @@ public:
                 // The groups of this chunk's schedule; a group with a particle that straddles the end of
                 // the piece (three threads or more) goes a particle at a time, without that one.
                 const SlotSource from{in_ring.ring, in_ring.ring, in_ring.mask, 0};
-                const std::vector<CanonicalSums::Group>& groups = down ? sums.groups_first : sums.groups_last;
-                const Index* group_start = down ? sums.group_first_start.data() : sums.group_last_start.data();
-                for (Index q = group_start[ch]; q < group_start[ch + 1]; ++q) {
-                    const CanonicalSums::Group& g = groups[std::size_t(q)];
+                const CanonicalSums::Schedule& schedule = down ? sums.by_first : sums.by_last;
+                for (Index q = schedule.group_start[ch]; q < schedule.group_start[ch + 1]; ++q) {
+                    const CanonicalSums::Group& g = schedule.groups[std::size_t(q)];
                     auto inside = [&](Index s) {
                         return down ? std::size_t(last_chunk[s]) < c1 : std::size_t(first_chunk[s]) >= c0;
                     };
@@ -94,7 +94,7 @@ public:
                         for (int l = 0; l < g.count; ++l) all = all && inside(g.grain[l]);
                     }
                     if (all) {
-                        sums.sum_group(g, in_ring.ring, walls, p);
+                        sums.sum_group(schedule, g, in_ring.ring, walls, p);
                         continue;
                     }
                     for (int l = 0; l < g.count; ++l)
@@ -104,18 +104,30 @@ public:
 #pragma omp barrier
             {
                 // The particles of this piece that straddle its meeting point m (their last chunk is one of
-                // m … m + span, shared out between the piece's two threads): their slots below m are in the
-                // upward thread's ring, those from m on in the downward one's (each holds the last
-                // ring_slots it wrote, and no sum reaches over more). A piece of one thread met at its end.
+                // m … m + span): their slots below m are in the upward thread's ring, those from m on in
+                // the downward one's (each holds the last ring_slots it wrote, and no sum reaches over
+                // more). The piece's two threads take half of them each, counted (most lie just above m,
+                // so a cut by chunk would leave nearly all to one thread), in runs (not every other one:
+                // neighbours in storage share the cache lines of the sums they store). A piece of one
+                // thread met at its end.
                 const std::size_t m = claims_[pc].met();
                 const std::size_t up = down ? t - 1 : t, other = !down && t + 1 == nt ? t : up + 1;
                 const SlotSource split{rings_[up].data(), rings_[other].data(), ring_slots - 1, std::size_t(pstart[std::min(n, m * kChunk)])};
-                const std::size_t e1 = std::min(c1, m + span + 1), mid = m + (e1 - m) / 2;
-                for (std::size_t ch = down ? mid : m; ch < (down ? e1 : mid); ++ch)
-                    for (Index e = last_start[ch]; e < last_start[ch + 1]; ++e) {
-                        const std::size_t s = std::size_t(by_last[e]), f = std::size_t(first_chunk[s]);
-                        if (f >= c0 && f < m) sums.sum_particle(s, split, list, walls, p);
-                    }
+                const std::size_t e1 = std::min(c1, m + span + 1);
+                auto for_each_straddler = [&](auto&& f) {
+                    for (std::size_t ch = m; ch < e1; ++ch)
+                        for (Index e = last_start[ch]; e < last_start[ch + 1]; ++e) {
+                            const std::size_t s = std::size_t(by_last[e]), first = std::size_t(first_chunk[s]);
+                            if (first >= c0 && first < m) f(s);
+                        }
+                };
+                std::size_t count = 0, at = 0;
+                for_each_straddler([&](std::size_t) { ++count; });
+                const std::size_t from = down ? count / 2 : 0, to = down ? count : count / 2;
+                for_each_straddler([&](std::size_t s) {
+                    if (at >= from && at < to) sums.sum_particle(s, split, list, walls, p);
+                    ++at;
+                });
             }
             if (!down && pc > 0) {
                 // Those whose first slot is in the piece before (all_ holds all the slots they read).
