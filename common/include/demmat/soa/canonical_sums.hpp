@@ -7,6 +7,7 @@
 // groups of kGroup particles summed side by side.
 #include <algorithm>
 #include <bit>
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
 #include <vector>
@@ -35,6 +36,8 @@ class CanonicalSums {
 public:
     static constexpr std::size_t kChunk = 128;  // particles per chunk of the sweep
     static constexpr int kGroup = 4;            // particles per sum group (sum_group)
+    // Where a slot's t_j, f and t_i start (pair_kernel.hpp's Slot), in doubles.
+    static constexpr std::size_t kTorqueJ = 0, kForce = 3, kTorqueI = 6;
 
     // A group of sums (sum_group): its particles (-1: none), the longest of their lists as j and as i,
     // and where its table starts in its schedule's table.
@@ -123,7 +126,7 @@ public:
     // next step's pass, vectorised, with the corrector: here, a grain at a time, its scalar divisions
     // would lengthen the force pass). The three components of a sum go as lanes of one quad (lane by
     // lane, the scalar additions; x - y is x + (-y)), each read as the quad that starts at it in the slot:
-    // f, t_i and t_j are three consecutive values, and the fourth lane, the next value along, is not used.
+    // t_j, f and t_i are three consecutive values, and the fourth lane, the next value along, is not used.
     void sum_particle(std::size_t s, const SlotSource& from, const NeighbourList& list, const WallContacts& walls, Particles& p) const
     {
         const double* lo = reinterpret_cast<const double*>(from.lo);
@@ -135,16 +138,16 @@ public:
         for (Index e = list.jstart[s]; e < list.jstart[s + 1]; ++e) {
             const std::size_t k = std::size_t(as_j[e]);
             Quad q;
-            load_quad(q, at(k, 0));
+            load_quad(q, at(k, kForce));
             f -= q;
-            load_quad(q, at(k, 6));
+            load_quad(q, at(k, kTorqueJ));
             tq += q;
         }
         for (Index k = list.start[s]; k < list.start[s + 1]; ++k) {
             Quad q;
-            load_quad(q, at(std::size_t(k), 0));
+            load_quad(q, at(std::size_t(k), kForce));
             f += q;
-            load_quad(q, at(std::size_t(k), 3));
+            load_quad(q, at(std::size_t(k), kTorqueI));
             tq += q;
         }
         walls.add(s, f, tq);
@@ -160,37 +163,35 @@ public:
     // is never -0, and x + ±0 = x for every other x), so each particle's bits are those of sum_particle
     // (the same order, kept there for the sums that read two rings or the list of all slots, which the
     // tables' ring offsets cannot name).
+    // A particle's force and torque are one vector of eight lanes, and each slot it reads one load of
+    // eight values: t_j and f as j (lanes: torque, then force, each added with the force's sign
+    // flipped, which is x - f bit for bit), f and t_i as i (force, then torque; the sum's lanes are
+    // swapped between the two). The last two lanes, the next values along, are not used.
     void sum_group(const Schedule& from, const Group& g, const Slot* ring, const WallContacts& walls, Particles& p) const
     {
-        const char* base = reinterpret_cast<const char*>(ring);
-        const char* ti = base + 3 * sizeof(double);  // where the torques start, for a slot at offset 0
-        const char* tj = base + 6 * sizeof(double);
-        auto add = [](Quad& sum, const char* at) {
-            Quad q;
-            std::memcpy(&q, at, sizeof(q));
-            sum += q;
-        };
-        auto subtract = [](Quad& sum, const char* at) {
-            Quad q;
-            std::memcpy(&q, at, sizeof(q));
-            sum -= q;
+        using Eight = Pack<double, 8>;
+        using Bits = Pack<std::uint64_t, 8>;
+        constexpr std::uint64_t kSign = std::uint64_t(1) << 63;
+        constexpr Bits flip_force = {0, 0, 0, kSign, kSign, kSign, 0, 0};
+        const char* as_j = reinterpret_cast<const char*>(ring) + kTorqueJ * sizeof(double);
+        const char* as_i = reinterpret_cast<const char*>(ring) + kForce * sizeof(double);
+        auto load = [](const char* at) {
+            Eight v;
+            std::memcpy(&v, at, sizeof(v));
+            return v;
         };
         const std::uint32_t* row = from.table.data() + g.table;
-        Quad f[kGroup]{}, tq[kGroup]{};
+        Eight sum[kGroup]{};
         for (std::int32_t e = 0; e < g.as_j; ++e, row += kGroup)
-            for (int l = 0; l < kGroup; ++l) {
-                subtract(f[l], base + row[l]);
-                add(tq[l], tj + row[l]);
-            }
+            for (int l = 0; l < kGroup; ++l) sum[l] += Eight(Bits(load(as_j + row[l])) ^ flip_force);
+        for (int l = 0; l < kGroup; ++l) sum[l] = __builtin_shufflevector(sum[l], sum[l], 3, 4, 5, 0, 1, 2, 6, 7);
         for (std::int32_t e = 0; e < g.as_i; ++e, row += kGroup)
-            for (int l = 0; l < kGroup; ++l) {
-                add(f[l], base + row[l]);
-                add(tq[l], ti + row[l]);
-            }
+            for (int l = 0; l < kGroup; ++l) sum[l] += load(as_i + row[l]);
         for (int l = 0; l < g.count; ++l) {
             const std::size_t s = std::size_t(g.grain[l]);
-            walls.add(s, f[l], tq[l]);
-            p.store_sum(s, f[l], tq[l]);
+            Quad f = __builtin_shufflevector(sum[l], sum[l], 0, 1, 2, 6), tq = __builtin_shufflevector(sum[l], sum[l], 3, 4, 5, 7);
+            walls.add(s, f, tq);
+            p.store_sum(s, f, tq);
         }
     }
 
@@ -258,5 +259,7 @@ private:
     std::vector<Index> last_bucket_, first_bucket_;  // scratch: one chunk's particles while they are grouped
     bool first_planned_ = false;
 };
+static_assert(offsetof(Slot, tj) == CanonicalSums::kTorqueJ * sizeof(double) && offsetof(Slot, f) == CanonicalSums::kForce * sizeof(double) &&
+              offsetof(Slot, ti) == CanonicalSums::kTorqueI * sizeof(double));
 
 } // namespace demmat::fast

@@ -20,9 +20,10 @@
 
 namespace demmat::fast {
 
-// One contact's result, kept in list order: force on i (on j it is -f), torque on i and on j.
+// One contact's result, kept in list order: torque on j, force on i (on j it is -f), torque on i. In
+// this order a sum reads t_j and f (as j) or f and t_i (as i) as six consecutive values (sum_group).
 struct Slot {
-    Vec3d f, ti, tj;
+    Vec3d tj, f, ti;
 };
 static_assert(sizeof(Slot) == 9 * sizeof(double));
 
@@ -55,7 +56,7 @@ private:
         char* bytes = reinterpret_cast<char*>(at);
         std::memcpy(bytes, &head, sizeof(Quad));
         std::memcpy(bytes + sizeof(Quad), &tail, sizeof(Quad));
-        at->tj.z = last;
+        at->ti.z = last;
     }
 };
 
@@ -187,13 +188,13 @@ private:
         else
             for (int l = 0; l < count; ++l) found += int(touch[l] != 0);
         if constexpr (Canonical) {
-            // A slot is nine values: f, t_i, t_j; the first eight go as two quads, the ninth alone.
-            const Lanes g0[4] = {c.f_i.x, c.f_i.y, c.f_i.z, c.t_i.x}, g1[4] = {c.t_i.y, c.t_i.z, c.t_j.x, c.t_j.y};
+            // A slot is nine values: t_j, f, t_i; the first eight go as two quads, the ninth alone.
+            const Lanes g0[4] = {c.t_j.x, c.t_j.y, c.t_j.z, c.f_i.x}, g1[4] = {c.f_i.y, c.f_i.z, c.t_i.x, c.t_i.y};
             Quad r0[kLanes], r1[kLanes];
             lanes_to_rows<Lanes>(g0, r0);
             lanes_to_rows<Lanes>(g1, r1);
             sink.put(k, count, [&](int l) -> const Quad& { return r0[l]; }, [&](int l) -> const Quad& { return r1[l]; },
-                     [&](int l) { return c.t_j.z[l]; });
+                     [&](int l) { return c.t_i.z[l]; });
         } else {
             // Added as they come, lane by lane (a particle may sit in several lanes).
             const Lanes zero{};
