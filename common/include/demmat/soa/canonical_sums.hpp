@@ -49,7 +49,7 @@ public:
 
     // One of the sweep's two schedules (by each particle's last chunk, or by its first): the particles
     // by chunk (order, from start[chunk]), each chunk's groups (from group_start[chunk]) and their
-    // tables of ring offsets (build_groups).
+    // tables of ring offsets (schedule()).
     struct Schedule {
         std::vector<Index> start, order, group_start;
         std::vector<Group> groups;
