@@ -38,16 +38,24 @@ template <class V>
 [[gnu::always_inline]] inline void rows_to_lanes(const Quad* rows, V out[4])
 {
     constexpr int W = lane_count<V>;
-    if constexpr (W == 8 || W == 4) {
-        Quad r[W];
-        for (int l = 0; l < W; ++l) r[l] = rows[l];
+    if constexpr (W == 8) {
+        // Rows l and l + 4 side by side in one vector, then two rounds of two-source shuffles (unpack
+        // within 128-bit pairs, then a permute across them): twelve shuffles for the pack.
+        using O = Pack<double, 8>;
+        O a[4], t[4];
+        for (int l = 0; l < 4; ++l) a[l] = __builtin_shufflevector(rows[l], rows[l + 4], 0, 1, 2, 3, 4, 5, 6, 7);
+        t[0] = __builtin_shufflevector(a[0], a[1], 0, 8, 2, 10, 4, 12, 6, 14);  // x0 x1 z0 z1 | x4 x5 z4 z5
+        t[1] = __builtin_shufflevector(a[0], a[1], 1, 9, 3, 11, 5, 13, 7, 15);  // y0 y1 w0 w1 | y4 y5 w4 w5
+        t[2] = __builtin_shufflevector(a[2], a[3], 0, 8, 2, 10, 4, 12, 6, 14);
+        t[3] = __builtin_shufflevector(a[2], a[3], 1, 9, 3, 11, 5, 13, 7, 15);
+        out[0] = __builtin_shufflevector(t[0], t[2], 0, 1, 8, 9, 4, 5, 12, 13);
+        out[1] = __builtin_shufflevector(t[1], t[3], 0, 1, 8, 9, 4, 5, 12, 13);
+        out[2] = __builtin_shufflevector(t[0], t[2], 2, 3, 10, 11, 6, 7, 14, 15);
+        out[3] = __builtin_shufflevector(t[1], t[3], 2, 3, 10, 11, 6, 7, 14, 15);
+    } else if constexpr (W == 4) {
+        Quad r[4] = {rows[0], rows[1], rows[2], rows[3]};
         transpose4(r[0], r[1], r[2], r[3]);
-        if constexpr (W == 8) {
-            transpose4(r[4], r[5], r[6], r[7]);
-            for (int c = 0; c < 4; ++c) out[c] = __builtin_shufflevector(r[c], r[4 + c], 0, 1, 2, 3, 4, 5, 6, 7);
-        } else {
-            for (int c = 0; c < 4; ++c) out[c] = r[c];
-        }
+        for (int c = 0; c < 4; ++c) out[c] = r[c];
     } else if constexpr (W == 2) {
         out[0] = __builtin_shufflevector(rows[0], rows[1], 0, 4);
         out[1] = __builtin_shufflevector(rows[0], rows[1], 1, 5);
@@ -65,16 +73,18 @@ template <class V>
 {
     constexpr int W = lane_count<V>;
     if constexpr (W == 8) {
-        Quad lo[4], hi[4];
-        for (int c = 0; c < 4; ++c) {
-            lo[c] = __builtin_shufflevector(in[c], in[c], 0, 1, 2, 3);
-            hi[c] = __builtin_shufflevector(in[c], in[c], 4, 5, 6, 7);
-        }
-        transpose4(lo[0], lo[1], lo[2], lo[3]);
-        transpose4(hi[0], hi[1], hi[2], hi[3]);
+        // The same shuffles backwards: u[l] holds rows l and l + 4.
+        using O = Pack<double, 8>;
+        const O t0 = __builtin_shufflevector(in[0], in[1], 0, 8, 2, 10, 4, 12, 6, 14);  // x0 y0 x2 y2 | x4 y4 x6 y6
+        const O t1 = __builtin_shufflevector(in[0], in[1], 1, 9, 3, 11, 5, 13, 7, 15);  // x1 y1 x3 y3 | x5 y5 x7 y7
+        const O t2 = __builtin_shufflevector(in[2], in[3], 0, 8, 2, 10, 4, 12, 6, 14);
+        const O t3 = __builtin_shufflevector(in[2], in[3], 1, 9, 3, 11, 5, 13, 7, 15);
+        const O u[4] = {__builtin_shufflevector(t0, t2, 0, 1, 8, 9, 4, 5, 12, 13), __builtin_shufflevector(t1, t3, 0, 1, 8, 9, 4, 5, 12, 13),
+                        __builtin_shufflevector(t0, t2, 2, 3, 10, 11, 6, 7, 14, 15),
+                        __builtin_shufflevector(t1, t3, 2, 3, 10, 11, 6, 7, 14, 15)};
         for (int l = 0; l < 4; ++l) {
-            rows[l] = lo[l];
-            rows[4 + l] = hi[l];
+            rows[l] = __builtin_shufflevector(u[l], u[l], 0, 1, 2, 3);
+            rows[4 + l] = __builtin_shufflevector(u[l], u[l], 4, 5, 6, 7);
         }
     } else if constexpr (W == 4) {
         Quad r[4] = {in[0], in[1], in[2], in[3]};
