@@ -90,7 +90,8 @@ public:
     template <bool Canonical>
     std::int64_t run(std::size_t k0, std::size_t k1, Load* load, const SlotSink& sink = {}) const
     {
-        std::size_t kept[kBlock], dropped[kBlock];
+        // (kLanes beyond a block: a pack's compressed indices are stored whole; see sort_pack.)
+        std::size_t kept[kBlock + kLanes], dropped[kBlock + kLanes];
         std::int64_t found = 0;
         for (std::size_t c0 = k0; c0 < k1; c0 += kBlock) {
             const std::size_t c1 = std::min(k1, c0 + kBlock);
@@ -112,12 +113,7 @@ public:
                 gather_lanes([&](int l) -> const Quad& { return kin_[owner_[k + std::size_t(l)]].xr; }, a);
                 gather_lanes([&](int l) -> const Quad& { return kin_[partner_[k + std::size_t(l)]].xr; }, b);
                 const auto t = may_touch_lanes(Vec3<Lanes>{a[0], a[1], a[2]}, Vec3<Lanes>{b[0], b[1], b[2]}, a[3], b[3]);
-                for (int l = 0; l < kLanes; ++l) {
-                    kept[nk] = k + std::size_t(l);
-                    dropped[nd] = k + std::size_t(l);
-                    nk += std::size_t(t[l] != 0);
-                    nd += std::size_t(t[l] == 0);
-                }
+                sort_pack(k, t, kept, nk, dropped, nd);
             }
             for (; k < c1; ++k) {
                 const Quad& a = kin_[owner_[k]].xr;
@@ -145,6 +141,35 @@ public:
 
 private:
     static constexpr std::size_t kBlock = 1024;  // candidates sorted into kept and dropped at a time
+
+    // Slots k, ..., k + kLanes - 1 onto the ends of kept (the lanes where t is set) and dropped (the
+    // others), in order. With AVX-512 each list takes its lanes' slots in one compressing shuffle and
+    // one whole store (kLanes places past its end must exist); elsewhere slot by slot, both lists
+    // written and one end advanced, with no branch.
+    template <class Test>
+    [[gnu::always_inline]] static void sort_pack(std::size_t k, const Test& t, std::size_t* kept, std::size_t& nk,
+                                                 std::size_t* dropped, std::size_t& nd)
+    {
+#if defined(__AVX512F__)
+        if constexpr (kLanes == 8 && sizeof(std::size_t) == 8) {
+            const __m512i lanes = (__m512i)t;
+            const __mmask8 in = _mm512_test_epi64_mask(lanes, lanes);
+            const __m512i slots = _mm512_add_epi64(_mm512_set1_epi64((long long)k), _mm512_set_epi64(7, 6, 5, 4, 3, 2, 1, 0));
+            _mm512_storeu_si512(kept + nk, _mm512_maskz_compress_epi64(in, slots));
+            _mm512_storeu_si512(dropped + nd, _mm512_maskz_compress_epi64(__mmask8(~in), slots));
+            const auto n_in = std::size_t(__builtin_popcount(unsigned(in)));
+            nk += n_in;
+            nd += std::size_t(kLanes) - n_in;
+            return;
+        }
+#endif
+        for (int l = 0; l < kLanes; ++l) {
+            kept[nk] = k + std::size_t(l);
+            dropped[nd] = k + std::size_t(l);
+            nk += std::size_t(t[l] != 0);
+            nd += std::size_t(t[l] == 0);
+        }
+    }
 
     // The law for up to kLanes slots at once (unused lanes repeat the last slot and are not stored):
     // both particles' records transposed into the lanes, particle_contact_lanes (the pair's coefficients
