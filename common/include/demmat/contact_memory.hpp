@@ -136,6 +136,7 @@ inline Vec3<T> spring(Vec3<T>& xi, const Vec3<T>& n, const Vec3<T>& vel, T k, T 
     const Vec3<T> f0 = (-k) * xi - eta * vel;
     const T f0_abs = lane_sqrt(dot(f0, f0));
     const auto slides = f0_abs > cap;
+    if (!lane_any(slides)) return f0;  // the selects below would keep ξ and f0 in every lane
     const auto stretched = dot(xi, xi) > zero;
     const Vec3<T> f = (cap / (slides ? f0_abs : splat<T>(S(1)))) * f0;
     const Vec3<T> xi_slid = (-(f + eta * vel)) / k;

@@ -79,6 +79,22 @@ inline V lane_sqrt(V a)
 template <class T>
 DEMMAT_HD inline T lane_min(T a, T b) { return b < a ? b : a; }
 
+// Whether a condition holds in any lane (a comparison of packs), or the condition itself for a scalar.
+// Where no lane takes a select's branch, the law can skip computing that branch: every lane's bits are
+// the same either way.
+DEMMAT_HD inline bool lane_any(bool c) { return c; }
+template <class Mask>
+    requires LanePack<Mask>
+inline bool lane_any(const Mask& c)
+{
+#if defined(__AVX512F__)
+    if constexpr (sizeof(Mask) == 64 && sizeof(c[0]) == 8) return _mm512_test_epi64_mask((__m512i)c, (__m512i)c) != 0;
+#endif
+    for (int l = 0; l < lane_count<Mask>; ++l)
+        if (c[l]) return true;
+    return false;
+}
+
 // Every lane s (a pack built from a scalar), or s itself for a scalar type.
 template <class V, class S>
 DEMMAT_HD inline V splat(S s)
