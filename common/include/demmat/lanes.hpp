@@ -95,6 +95,15 @@ inline bool lane_any(const Mask& c)
     return false;
 }
 
+namespace detail {
+// One initialiser of every lane: one broadcast (a loop of lane stores became one masked broadcast per lane).
+template <class V, class S, std::size_t... L>
+inline V splat_lanes(S s, std::index_sequence<L...>)
+{
+    return V{((void)L, s)...};
+}
+} // namespace detail
+
 // Every lane s (a pack built from a scalar), or s itself for a scalar type.
 template <class V, class S>
 DEMMAT_HD inline V splat(S s)
@@ -102,9 +111,7 @@ DEMMAT_HD inline V splat(S s)
     if constexpr (std::is_arithmetic_v<V>) {
         return V(s);
     } else {
-        V r{};
-        for (int l = 0; l < lane_count<V>; ++l) r[l] = s;
-        return r;
+        return detail::splat_lanes<V>(LaneScalar<V>(s), std::make_index_sequence<std::size_t(lane_count<V>)>{});
     }
 }
 
