@@ -1,7 +1,8 @@
 #!/usr/bin/python3
-"""The fast variant's benchmark (scripts/bench_fast.sh) as one table: µs per particle-step of arrays,
+"""The fast variant's benchmark (scripts/bench_fast.sh) as tables: µs per particle-step of arrays,
 fast and fast_unordered on the settled bed for each N and thread count, each phase's share, the
-speed-up from one to two threads, and the 10⁶-particle run's time and peak memory.
+speed-up from one to two threads; what the canonical order costs (fast over fast_unordered, as the
+ratio of the medians and paired within each repetition); and the 10⁶-particle run's time and peak memory.
 
 Usage: /usr/bin/python3 analysis/summarise_fast.py results/fast [-o results/fast/summary.md]
 """
@@ -16,11 +17,25 @@ from atomic_io import write_text
 import results
 
 
+def canonical_cost(tot, state, n):
+    """fast over fast_unordered per thread count: each repetition's two totals were taken side by side
+    (one interleaved round), so their ratio is the order's cost with the machine's drift cancelled."""
+    variants = set(tot.index.get_level_values("variant"))
+    if not {"fast", "fast_unordered"} <= variants:
+        return []
+    out = []
+    for t in tot.columns:
+        ratio = (tot.loc["fast"][t] / tot.loc["fast_unordered"][t]).dropna()
+        if not ratio.empty:
+            out.append({"state": state, "N": n, "threads": int(t), "paired": ratio.median(), "paired_min": ratio.min(), "paired_max": ratio.max()})
+    return out
+
+
 def read(folder):
     """One row per (state, N, variant, threads) from bench_settled_<N>.json and bench_loose_<N>.json
     (every thread count in one run, interleaved); also the paired speed-ups: per repetition, the 1-thread total over the t-thread total
-    of the same variant, taken side by side."""
-    rows, paired, prov = [], [], {}
+    of the same variant, taken side by side; and the canonical order's paired cost (canonical_cost)."""
+    rows, paired, costs, prov = [], [], [], {}
     for path in sorted(folder.glob("bench_*.json")):
         m = re.fullmatch(r"bench_(settled|loose)_(\d+)\.json", path.name)
         if not m:
@@ -45,13 +60,14 @@ def read(folder):
             })
         asked = "threads_asked" if "threads_asked" in res.table.columns else "threads"
         tot = res.table.groupby(["variant", asked, "repetition"])["seconds"].sum().unstack(asked)
+        costs += canonical_cost(tot, state, n)
         if 1 in tot.columns:
             for t in tot.columns:
                 if t != 1:
                     ratio = (tot[1] / tot[t]).dropna()
                     for v, r in ratio.groupby(level="variant"):
                         paired.append({"state": state, "N": n, "variant": v, "threads": int(t), "paired": r.median(), "paired_min": r.min(), "paired_max": r.max()})
-    return pd.DataFrame(rows), pd.DataFrame(paired), prov
+    return pd.DataFrame(rows), pd.DataFrame(paired), pd.DataFrame(costs), prov
 
 
 def provenance_line(prov):
@@ -72,7 +88,7 @@ def main(argv):
     ap.add_argument("folder", type=pathlib.Path)
     ap.add_argument("-o", "--output", type=pathlib.Path)
     a = ap.parse_args(argv)
-    df, paired, prov = read(a.folder)
+    df, paired, costs, prov = read(a.folder)
     if df.empty:
         print(f"summarise_fast.py: no bench_settled_<N>.json or bench_loose_<N>.json in {a.folder}", file=sys.stderr)
         return 1
@@ -106,6 +122,18 @@ def main(argv):
         out.append(f"| {r['state']} | {r['N']} | {r['variant']} | {threads} | {r['us_per_particle_step']:.3f} | {r['min_us']:.3f}–{r['max_us']:.3f} | "
                    f"{r['speed-up vs 1 thread']:.2f} | {p} | {r['vs arrays (1 thread)']:.2f} | {r['predict %']:.0f} % | {r['search %']:.0f} % | "
                    f"{r['forces %']:.0f} % | {r['correct %']:.0f} % | {r['contacts/particle']:.2f} | {r['bytes/particle']:.0f} |")
+    if not costs.empty:
+        med = df.set_index(["state", "N", "variant", "threads"])["us_per_particle_step"]
+        out += ["", "## What the canonical order costs", "",
+                "fast (bit-identical for any thread count) over fast_unordered (the same code without the canonical order):"
+                " the ratio of the medians above, and the paired ratio, the median (min–max) over the repetitions of each"
+                " repetition's own ratio, its two samples taken side by side in one interleaved round.", "",
+                "| state | N | threads | fast / fast_unordered (medians) | paired |", "|---|---:|---:|---:|---|"]
+        costs["state order"] = costs.state.map({"settled": 0, "loose": 1})
+        for _, c in costs.sort_values(["state order", "N", "threads"]).iterrows():
+            key = (c["state"], c["N"])
+            ratio = med.get(key + ("fast", c["threads"]), float("nan")) / med.get(key + ("fast_unordered", c["threads"]), float("nan"))
+            out.append(f"| {c['state']} | {c['N']} | {c['threads']} | {ratio:.3f} | {c['paired']:.3f} ({c['paired_min']:.3f}–{c['paired_max']:.3f}) |")
     million = a.folder / "million.json"
     mtime = a.folder / "million_time.txt"
     if million.exists() and mtime.exists():

@@ -6,7 +6,7 @@
 # that it fits (peak memory from /usr/bin/time).
 # Writes results/fast/bench_settled_<N>.json and bench_loose_1000000.json (+ .txt; every thread count,
 # interleaved), results/fast/million.txt and the table
-# results/fast/summary.md (analysis/summarise_fast.py).
+# results/fast/summary.md (analysis/summarise_fast.py: the tables, and what the canonical order costs, paired).
 # Timed steps per repetition are 5·10^6/N (at least 20), so each sample is ~10^6–10^7 particle-steps.
 # Usage: scripts/bench_fast.sh [--sizes "1000 10000 100000"] [--threads "1 2"] [--repetitions R]
 #                              [--settle-time T] [--no-million] [--settle-only] [--build-dir DIR]

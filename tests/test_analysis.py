@@ -97,6 +97,36 @@ class Loader(unittest.TestCase):
         finally:
             shutil.rmtree(work)
 
+    def test_summarise_fast_pairs_fast_with_fast_unordered_within_each_repetition(self):
+        # the sample's arrays samples as fast_unordered's on fast's threads: the paired cost is, per
+        # repetition, fast's total over the other's, and the table gives their median, min and max
+        import json
+        raw = json.load(open(os.path.join(DATA, "bench_sample.json")))
+        for x in raw["samples"] + raw["summary"]:
+            if x["variant"] == "arrays":
+                x["variant"], x["threads"] = "fast_unordered", 2
+        totals = {}
+        for x in raw["samples"]:
+            key = (x["variant"], x["repetition"])
+            totals[key] = totals.get(key, 0.0) + x["seconds_per_step"]
+        ratios = sorted(totals[("fast", r)] / totals[("fast_unordered", r)] for r in range(raw["repetitions"]))
+        self.assertNotAlmostEqual(ratios[0], ratios[-1], places=3)  # two distinct repetitions, so min ≠ max
+        work = tempfile.mkdtemp()
+        try:
+            with open(os.path.join(work, "bench_settled_2000.json"), "w") as f:
+                json.dump(raw, f)
+            out = os.path.join(work, "summary.md")
+            subprocess.run([sys.executable, os.path.join(ANALYSIS, "summarise_fast.py"), work, "-o", out], check=True)
+            text = open(out).read()
+            self.assertIn("## What the canonical order costs", text)
+            row = [line for line in text.splitlines() if line.startswith("| settled | 2000 | 2 |")]
+            self.assertEqual(len(row), 1)
+            paired = row[0].split("|")[5].strip()
+            median = (ratios[0] + ratios[-1]) / 2  # two repetitions
+            self.assertEqual(paired, f"{median:.3f} ({ratios[0]:.3f}–{ratios[-1]:.3f})")
+        finally:
+            shutil.rmtree(work)
+
     def test_google_benchmark(self):
         r = results.load(os.path.join(DATA, "gbench_sample.json"))
         self.assertEqual(r.kind, "gbench")
