@@ -124,6 +124,8 @@ class Loader(unittest.TestCase):
             paired = row[0].split("|")[5].strip()
             median = (ratios[0] + ratios[-1]) / 2  # two repetitions
             self.assertEqual(paired, f"{median:.3f} ({ratios[0]:.3f}–{ratios[-1]:.3f})")
+            us = {x["variant"]: x["us_per_particle_step"] for x in raw["summary"]}
+            self.assertEqual(row[0].split("|")[4].strip(), f"{us['fast'] / us['fast_unordered']:.3f}")
         finally:
             shutil.rmtree(work)
 

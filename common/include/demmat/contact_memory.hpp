@@ -7,7 +7,8 @@
 //
 // A memory model always has the paper's other features on (rotation, friction, damping, walls, moving
 // walls, polydisperse): R* and m* are computed per contact. Every branch of the law is a select, so
-// the scalar form and the lanes form (lanes.hpp) are one text, bit for bit alike.
+// the scalar form and the lanes form (lanes.hpp) are one text, bit for bit alike; the one skip (a
+// spring that slides in no lane) is taken only where the selects it skips would change no lane.
 #include <cmath>
 #include <string>
 

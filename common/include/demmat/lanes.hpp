@@ -96,7 +96,8 @@ inline bool lane_any(const Mask& c)
 }
 
 namespace detail {
-// One initialiser of every lane: one broadcast (a loop of lane stores became one masked broadcast per lane).
+// One initialiser of every lane, which compiles to one broadcast (a loop of lane stores compiled to
+// one masked broadcast per lane).
 template <class V, class S, std::size_t... L>
 inline V splat_lanes(S s, std::index_sequence<L...>)
 {

@@ -90,8 +90,7 @@ public:
     template <bool Canonical>
     std::int64_t run(std::size_t k0, std::size_t k1, Load* load, const SlotSink& sink = {}) const
     {
-        // (kLanes beyond a block: a pack's compressed indices are stored whole; see sort_pack.)
-        std::size_t kept[kBlock + kLanes], dropped[kBlock + kLanes];
+        std::size_t kept[kBlock], dropped[kBlock];
         std::int64_t found = 0;
         for (std::size_t c0 = k0; c0 < k1; c0 += kBlock) {
             const std::size_t c1 = std::min(k1, c0 + kBlock);
@@ -144,8 +143,9 @@ private:
 
     // Slots k, ..., k + kLanes - 1 onto the ends of kept (the lanes where t is set) and dropped (the
     // others), in order. With AVX-512 each list takes its lanes' slots in one compressing shuffle and
-    // one whole store (kLanes places past its end must exist); elsewhere slot by slot, both lists
-    // written and one end advanced, with no branch.
+    // one whole store of kLanes places, the unused ones past its new end: the lists then hold
+    // nk + nd = k - c0 slots and k + kLanes <= c1 <= c0 + kBlock, so the store stays in the block.
+    // Elsewhere slot by slot, both lists written and one end advanced, with no branch.
     template <class Test>
     [[gnu::always_inline]] static void sort_pack(std::size_t k, const Test& t, std::size_t* kept, std::size_t& nk,
                                                  std::size_t* dropped, std::size_t& nd)
