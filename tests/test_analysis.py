@@ -82,20 +82,25 @@ class Loader(unittest.TestCase):
         self.assertEqual(fast["sample"].nunique(), 4)  # 2 configurations × 2 repetitions
         self.assertEqual(len(results.wide(r.table)), 6)
 
-    def test_summarise_fast_keys_rows_by_the_threads_asked(self):
-        # fast asked for 1 and 2 threads on a small bed runs on 1 both times: two rows, the second saying so
+    @staticmethod
+    def summarise_fast(raw):
+        """summarise_fast.py's summary of one bench JSON, as the settled bed of 2000."""
         import json
-        raw = self.fast_asked_for_1_and_2_threads_ran_on_1()
         work = tempfile.mkdtemp()
         try:
             with open(os.path.join(work, "bench_settled_2000.json"), "w") as f:
                 json.dump(raw, f)
             out = os.path.join(work, "summary.md")
             subprocess.run([sys.executable, os.path.join(ANALYSIS, "summarise_fast.py"), work, "-o", out], check=True)
-            rows = [line for line in open(out) if line.startswith("| settled | 2000 | fast |")]
-            self.assertEqual([r.split("|")[4].strip() for r in rows], ["1", "2 (ran on 1)"])
+            return open(out).read()
         finally:
             shutil.rmtree(work)
+
+    def test_summarise_fast_keys_rows_by_the_threads_asked(self):
+        # fast asked for 1 and 2 threads on a small bed runs on 1 both times: two rows, the second saying so
+        text = self.summarise_fast(self.fast_asked_for_1_and_2_threads_ran_on_1())
+        rows = [line for line in text.splitlines() if line.startswith("| settled | 2000 | fast |")]
+        self.assertEqual([r.split("|")[4].strip() for r in rows], ["1", "2 (ran on 1)"])
 
     def test_summarise_fast_pairs_fast_with_fast_unordered_within_each_repetition(self):
         # the sample's arrays samples as fast_unordered's on fast's threads: the paired cost is, per
@@ -111,23 +116,15 @@ class Loader(unittest.TestCase):
             totals[key] = totals.get(key, 0.0) + x["seconds_per_step"]
         ratios = sorted(totals[("fast", r)] / totals[("fast_unordered", r)] for r in range(raw["repetitions"]))
         self.assertNotAlmostEqual(ratios[0], ratios[-1], places=3)  # two distinct repetitions, so min ≠ max
-        work = tempfile.mkdtemp()
-        try:
-            with open(os.path.join(work, "bench_settled_2000.json"), "w") as f:
-                json.dump(raw, f)
-            out = os.path.join(work, "summary.md")
-            subprocess.run([sys.executable, os.path.join(ANALYSIS, "summarise_fast.py"), work, "-o", out], check=True)
-            text = open(out).read()
-            self.assertIn("## What the canonical order costs", text)
-            row = [line for line in text.splitlines() if line.startswith("| settled | 2000 | 2 |")]
-            self.assertEqual(len(row), 1)
-            paired = row[0].split("|")[5].strip()
-            median = (ratios[0] + ratios[-1]) / 2  # two repetitions
-            self.assertEqual(paired, f"{median:.3f} ({ratios[0]:.3f}–{ratios[-1]:.3f})")
-            us = {x["variant"]: x["us_per_particle_step"] for x in raw["summary"]}
-            self.assertEqual(row[0].split("|")[4].strip(), f"{us['fast'] / us['fast_unordered']:.3f}")
-        finally:
-            shutil.rmtree(work)
+        text = self.summarise_fast(raw)
+        self.assertIn("## What the canonical order costs", text)
+        row = [line for line in text.splitlines() if line.startswith("| settled | 2000 | 2 |")]
+        self.assertEqual(len(row), 1)
+        paired = row[0].split("|")[5].strip()
+        median = (ratios[0] + ratios[-1]) / 2  # two repetitions
+        self.assertEqual(paired, f"{median:.3f} ({ratios[0]:.3f}–{ratios[-1]:.3f})")
+        us = {x["variant"]: x["us_per_particle_step"] for x in raw["summary"]}
+        self.assertEqual(row[0].split("|")[4].strip(), f"{us['fast'] / us['fast_unordered']:.3f}")
 
     def test_google_benchmark(self):
         r = results.load(os.path.join(DATA, "gbench_sample.json"))
