@@ -1,9 +1,10 @@
 #!/usr/bin/python3
 """The suite beside LAMMPS and LIGGGHTS (docs/peers.md); run by scripts/run_peers.sh with /usr/bin/python3.
 
-  plot_peers.py bench --work DIR --samples CSV --versions JSON --out DIR --figure PNG
-      medians of the interleaved repetitions (suite variants from `demmat bench --json`, peers from their
-      loop times), µs per particle-step against N, and each variant's ratio to LAMMPS in the same run.
+  plot_peers.py bench --work DIR --versions JSON --out DIR --figure PNG
+      medians of the interleaved repetitions (suite variants from `demmat bench --json`, peers from the
+      logs of their timed runs), µs per particle-step against N, each variant's ratio to LAMMPS in the
+      same run, and where the time goes on the settled bed (each code's own phases).
   plot_peers.py observables --dump FILE --scene TOML --code C --member M --stage S -o CSV
       per frame of a LAMMPS-style dump: kinetic energy, bed height, normal force on the x_max wall,
       computed the same way for every code.
@@ -18,6 +19,7 @@ import glob
 import json
 import math
 import os
+import re
 import sys
 import tomllib
 
@@ -35,9 +37,43 @@ STAGES = ["loose", "bed", "compression"]
 STAGE_TITLE = {"loose": "loose grid (t = 0)", "bed": "settled bed", "compression": "compression stage"}
 
 
-# ---- bench ---------------------------------------------------------------------------------------------
+# ---- bench ----------------------------------------------------------------------------------------------
+SUITE_PHASES = ["predict", "search", "forces", "correct"]
+PEER_PHASES = ["pair", "neigh", "rest"]
+# The phases side by side (write_bench's table): what each code times, in the order of a step.
+PHASE_TITLE = {"predict": "predict + correct (Gear pass, records, wall listing)", "search": "search (list rebuilds)",
+               "forces": "forces (pairs, walls, sums)", "pair": "Pair (the pair style)", "neigh": "Neigh (list rebuilds)",
+               "rest": "the rest (fixes: integration, gravity, walls; other)"}
+PEER_LOG = re.compile(r"^(lammps|liggghts)_n(\d+)_(.+)_r(\d+)\.out$")
+
+
+def read_peer_log(path):
+    """A LAMMPS or LIGGGHTS run's last loop (the timed run after the warm-up), in seconds per step: the
+    total ('Loop time of') and its breakdown: the pair style, the neighbour lists, and the rest (fixes, among
+    them the integrator and the walls, communication, output, other). LAMMPS prints its breakdown as
+    'Pair | min | avg | max | ...' rows, LIGGGHTS (a LAMMPS of 2013) as 'Pair  time (%) = t (p)' lines.
+    Returns (steps, particles, {phase: seconds per step})."""
+    text = open(path).read()
+    loops = list(re.finditer(r"^Loop time of (\S+) on \d+ procs? for (\d+) steps with (\d+) atoms", text, re.M))
+    if not loops:
+        sys.exit(f"plot_peers.py: {path}: no 'Loop time of' line: the run failed (its output is that file)")
+    last = loops[-1]
+    total, steps, particles = float(last[1]), int(last[2]), int(last[3])
+    tail = text[last.end():]
+    sections = {}
+    for name, avg in re.findall(r"^(Pair|Neigh)\s*\|[^|]*\|\s*(\S+)\s*\|", tail, re.M):  # avg, the middle column
+        sections.setdefault(name, float(avg))
+    for name, t in re.findall(r"^(Pair|Neigh)\s+time \(%\) = (\S+)", tail, re.M):
+        sections.setdefault(name, float(t))
+    if set(sections) != {"Pair", "Neigh"}:
+        sys.exit(f"plot_peers.py: {path}: no Pair and Neigh times after the last 'Loop time of'")
+    pair, neigh = sections["Pair"], sections["Neigh"]
+    return steps, particles, {"total": total / steps, "pair": pair / steps, "neigh": neigh / steps,
+                              "rest": (total - pair - neigh) / steps}
+
+
 def cmd_bench(a):
-    rows = pd.read_csv(a.samples).to_dict("records")
+    rows = []
     provenance = None
     for f in sorted(glob.glob(os.path.join(a.work, "suite_n*_*_r*.json"))):
         res = load(f)
@@ -45,9 +81,20 @@ def cmd_bench(a):
         stem = os.path.basename(f)[len("suite_n"):-len(".json")]
         n, stage, rep = stem.split("_")[0], "_".join(stem.split("_")[1:-1]), stem.split("_")[-1][1:]
         for s in res.meta["summary"]:
-            rows.append({"code": "suite", "variant": s["variant"], "particles": int(n), "stage": stage,
-                         "repetition": int(rep), "steps": res.meta["steps"],
-                         "seconds_per_step": s["seconds_per_step"]["total"]["median"]})
+            for phase in ["total"] + SUITE_PHASES:
+                rows.append({"code": "suite", "variant": s["variant"], "particles": int(n), "stage": stage,
+                             "repetition": int(rep), "steps": res.meta["steps"], "phase": phase,
+                             "seconds_per_step": s["seconds_per_step"][phase]["median"]})
+    for f in sorted(glob.glob(os.path.join(a.work, "*.out"))):
+        m = PEER_LOG.match(os.path.basename(f))
+        if not m:
+            continue
+        code, n, stage, rep = m[1], int(m[2]), m[3], int(m[4])
+        steps, particles, seconds = read_peer_log(f)
+        if particles != n:
+            sys.exit(f"plot_peers.py: {f}: {particles} atoms, not the {n} of its name")
+        rows += [{"code": code, "variant": code, "particles": n, "stage": stage, "repetition": rep, "steps": steps,
+                  "phase": phase, "seconds_per_step": t} for phase, t in seconds.items()]
     write_bench(pd.DataFrame(rows), provenance, json.load(open(a.versions)), a.out, a.figure)
 
 
@@ -56,7 +103,8 @@ def write_bench(df, provenance, versions, out, figure):
     if df.empty:
         sys.exit("plot_peers.py: no samples")
     df["us_per_particle_step"] = df["seconds_per_step"] / df["particles"] * 1e6
-    g = df.groupby(["code", "variant", "stage", "particles"])["us_per_particle_step"]
+    phases = df[df.phase != "total"]
+    g = df[df.phase == "total"].groupby(["code", "variant", "stage", "particles"])["us_per_particle_step"]
     med = g.median().rename("median").to_frame().join(g.min().rename("min")).join(g.max().rename("max")) \
         .join(g.count().rename("repetitions")).reset_index()
     lam = med[med.code == "lammps"].set_index(["stage", "particles"])["median"]
@@ -122,8 +170,34 @@ def write_bench(df, provenance, versions, out, figure):
         lam_row = [m[(m.variant == 'lammps') & (m.particles == n)]["median"] for n in ns]
         lines.append("| *LAMMPS µs per particle-step* | " + " | ".join("" if r.empty else f"{r.iloc[0]:.3f}" for r in lam_row) + " |")
         lines.append("")
+    lines += phase_table(phases, "bed")
     write_text(os.path.join(out, "bench_peers.md"), "\n".join(lines))
     print(f"results: {csv}, {os.path.join(out, 'bench_peers.json')}, {os.path.join(out, 'bench_peers.md')}, {figure}")
+
+
+def phase_table(phases, stage):
+    """Markdown: µs per particle-step by each code's own phases on one stage (median over the repetitions),
+    the suite's predict and correct as one row (fast does its corrector in the next step's Gear pass)."""
+    p = phases[phases.stage == stage].copy()
+    if p.empty:
+        return []
+    p["phase"] = p.phase.replace({"correct": "predict"})
+    per_rep = p.groupby(["code", "variant", "particles", "phase", "repetition"])["us_per_particle_step"].sum()
+    med = per_rep.groupby(["code", "variant", "particles", "phase"]).median()
+    ns = sorted(p.particles.unique())
+    lines = [f"## Where the time goes: {STAGE_TITLE[stage]}", "",
+             "µs per particle-step in each code's own phases (median over the repetitions). The phases do not "
+             "map one to one: the walls' law is in the suite's forces and in the peers' fixes (the rest); "
+             "docs/peers.md says what each phase holds.", "",
+             "| code | phase | " + " | ".join(f"N = {n}" for n in ns) + " |",
+             "|---|---|" + "---:|" * len(ns)]
+    variants = sorted(p.variant.unique(), key=lambda v: (v in ("lammps", "liggghts"), v))
+    for v in variants:
+        code = p[p.variant == v].code.iloc[0]
+        for phase in (["predict", "search", "forces"] if code == "suite" else PEER_PHASES):
+            cells = [med.get((code, v, n, phase), float("nan")) for n in ns]
+            lines.append(f"| {v} | {PHASE_TITLE[phase]} | " + " | ".join("" if math.isnan(c) else f"{c:.4f}" for c in cells) + " |")
+    return lines + [""]
 
 
 # ---- observables -----------------------------------------------------------------------------------------
@@ -275,7 +349,7 @@ def write_physics(df, versions, particles, amplitude, out, figure):
 def cmd_replot_bench(a):
     """The tables and the figure again from bench_peers.json (every sample is in it), beside it."""
     res = load(a.json)
-    df = res.table.drop(columns=["threads", "phase", "sample"]).rename(columns={"N": "particles", "seconds": "seconds_per_step"})
+    df = res.table.drop(columns=["threads", "sample"]).rename(columns={"N": "particles", "seconds": "seconds_per_step"})
     write_bench(df.drop(columns=["us_per_particle_step"]), res.provenance, res.meta["peers"], os.path.dirname(a.json), a.figure)
 
 
@@ -291,7 +365,6 @@ def main():
     sub = ap.add_subparsers(dest="cmd", required=True)
     b = sub.add_parser("bench")
     b.add_argument("--work", required=True)
-    b.add_argument("--samples", required=True)
     b.add_argument("--versions", required=True)
     b.add_argument("--out", required=True)
     b.add_argument("--figure", required=True)

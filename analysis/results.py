@@ -91,7 +91,9 @@ def load(path):
         return _run(path, raw)
     if "peers" in raw and "summary" in raw:
         df = pd.DataFrame(raw["samples"]).rename(columns={"particles": "N", "seconds_per_step": "seconds"})
-        df["threads"], df["phase"], df["sample"] = 1, "total", range(len(df))  # one core per code; the step's time
+        df["threads"], df["sample"] = 1, range(len(df))  # one core per code
+        if "phase" not in df:  # files of before the phases: the step's time only
+            df["phase"] = "total"
         return Result("peers", path, normalise_provenance(raw.get("provenance")), df,
                       {k: v for k, v in raw.items() if k not in ("samples", "provenance")})
     if "rows" in raw and "mode" in raw:

@@ -4,7 +4,7 @@
 # file so that every code starts from the identical particles, then
 #  1. the peer benchmark: every code on one core (OMP_NUM_THREADS=1, no MPI) for the loose grid, the
 #     settled bed and the compression stage, N in the list, repetitions interleaved (the codes' order
-#     rotated every repetition), timings from each code's own loop time; results/peers/bench_*.
+#     rotated every repetition), timings from each code's own loop time and its phases; results/peers/bench_*.
 #  2. the physics cross-check: an ensemble of perturbed starts per code from the same particles, the
 #     kinetic energy and bed height while settling, the wall force while compressing; results/peers/physics_*.
 # Usage: scripts/run_peers.sh [--full] [--n "1000 2000"] [--steps K] [--repetitions R] [--variants LIST]
@@ -124,13 +124,10 @@ if [[ $prepare_only == 1 ]]; then
   exit 0
 fi
 
-# "Loop time of X on 1 procs for K steps": the timed (last) run's seconds.
-loop_time() { grep "^Loop time of" "$1" | tail -1 | awk '{print $4}'; }
-
 if [[ $do_bench == 1 ]]; then
-  samples=$work/bench_samples.csv
-  echo "code,variant,particles,stage,repetition,steps,seconds_per_step" > "$samples"
-  rm -f "$work"/suite_n*_*.json
+  # Each run's raw output stays in $work: the suite's `demmat bench --json`, the peers' logs, whose last
+  # loop time and breakdown plot_peers.py reads.
+  rm -f "$work"/suite_n*_*.json "$work"/lammps_n*_*.out "$work"/liggghts_n*_*.out
   for n in $ns; do prepare "$n"; done
   codes=(suite lammps); [[ -n "$liggghts" ]] && codes+=(liggghts)
   for ((r = 0; r < reps; r++)); do
@@ -145,19 +142,17 @@ if [[ $do_bench == 1 ]]; then
                 --json "$work/suite_n${n}_${stage}_r${r}.json" >/dev/null 2>&1 ;;
             lammps)
               (cd "$d" && $lmp -var frag "$stage.lammps" -var warmup "$warmup" -var steps "$steps" \
-                 -in "$OLDPWD/peers/lammps/in.bench" -log none -nocite > "$work/lammps.out" 2>&1)
-              echo "lammps,lammps,$n,$stage,$r,$steps,$(awk -v t="$(loop_time "$work/lammps.out")" -v k="$steps" 'BEGIN{printf "%.9e", t/k}')" >> "$samples" ;;
+                 -in "$OLDPWD/peers/lammps/in.bench" -log none -nocite > "$work/lammps_n${n}_${stage}_r${r}.out" 2>&1) ;;
             liggghts)
               (cd "$d" && $liggghts -var frag "$stage.liggghts" -var warmup "$warmup" -var steps "$steps" \
-                 -in "$OLDPWD/peers/liggghts/in.bench" -log none -nocite > "$work/liggghts.out" 2>&1)
-              echo "liggghts,liggghts,$n,$stage,$r,$steps,$(awk -v t="$(loop_time "$work/liggghts.out")" -v k="$steps" 'BEGIN{printf "%.9e", t/k}')" >> "$samples" ;;
+                 -in "$OLDPWD/peers/liggghts/in.bench" -log none -nocite > "$work/liggghts_n${n}_${stage}_r${r}.out" 2>&1) ;;
           esac
         done
       done
     done
     echo "== benchmark repetition $((r + 1))/$reps done"
   done
-  $PYTHON analysis/plot_peers.py bench --work "$work" --samples "$samples" --versions "$work/versions.json" \
+  $PYTHON analysis/plot_peers.py bench --work "$work" --versions "$work/versions.json" \
     --out "$out" --figure "$figures/peers_us_per_particle_step.png"
 fi
 

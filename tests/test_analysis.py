@@ -153,6 +153,100 @@ class Loader(unittest.TestCase):
                 results.load(f.name)
 
 
+LAMMPS_LOG = """Loop time of 0.305351 on 1 procs for 20 steps with 64000 atoms
+
+MPI task timing breakdown:
+Section |  min time  |  avg time  |  max time  |%varavg| %total
+---------------------------------------------------------------
+Pair    | 0.21625    | 0.21625    | 0.21625    |   0.0 | 70.82
+Neigh   | 0          | 0          | 0          |   0.0 |  0.00
+Modify  | 0.081452   | 0.081452   | 0.081452   |   0.0 | 26.67
+Other   |            | 0.0074     |            |       |  2.42
+
+Loop time of 3.16708 on 1 procs for 200 steps with 64000 atoms
+
+MPI task timing breakdown:
+Section |  min time  |  avg time  |  max time  |%varavg| %total
+---------------------------------------------------------------
+Pair    | 2.2243     | 2.2243     | 2.2243     |   0.0 | 70.23
+Neigh   | 0.046851   | 0.046851   | 0.046851   |   0.0 |  1.48
+Comm    | 0.0007862  | 0.0007862  | 0.0007862  |   0.0 |  0.02
+Output  | 0.00020045 | 0.00020045 | 0.00020045 |   0.0 |  0.01
+Modify  | 0.8222     | 0.8222     | 0.8222     |   0.0 | 25.96
+Other   |            | 0.07277    |            |       |  2.30
+"""
+LIGGGHTS_LOG = """Loop time of 0.246299 on 1 procs for 20 steps with 64000 atoms, finish time Thu Dec  3 19:18:13 2026
+
+Pair  time (%) = 0.200092 (81.2396)
+Neigh time (%) = 0 (0)
+Other time (%) = 0.0459612 (18.6608)
+
+Loop time of 2.75224 on 1 procs for 200 steps with 64000 atoms, finish time Thu Dec  3 19:18:16 2026
+
+Pair  time (%) = 2.17117 (78.8875)
+Neigh time (%) = 0.0911109 (3.31043)
+Comm  time (%) = 0.0012078 (0.0438842)
+Outpt time (%) = 0.000221471 (0.00804695)
+Other time (%) = 0.488526 (17.7501)
+"""
+
+
+class PeersBench(unittest.TestCase):
+    """plot_peers.py bench: the peers' logs (trimmed real outputs of Debian's lmp and liggghts) and the table
+    of each code's phases."""
+
+    def setUp(self):
+        import plot_peers
+        self.peers = plot_peers
+        self.work = tempfile.mkdtemp()
+        self.addCleanup(shutil.rmtree, self.work)
+
+    def log(self, name, text):
+        path = os.path.join(self.work, name)
+        with open(path, "w") as f:
+            f.write(text)
+        return path
+
+    def test_the_timed_loop_is_the_last_and_the_rest_is_what_pair_and_neigh_leave(self):
+        for text, pair, neigh in ((LAMMPS_LOG, 2.2243, 0.046851), (LIGGGHTS_LOG, 2.17117, 0.0911109)):
+            steps, particles, sec = self.peers.read_peer_log(self.log("x.out", text))
+            total = 3.16708 if text is LAMMPS_LOG else 2.75224
+            self.assertEqual((steps, particles), (200, 64000))
+            self.assertAlmostEqual(sec["total"], total / 200, places=15)
+            self.assertAlmostEqual(sec["pair"], pair / 200, places=15)
+            self.assertAlmostEqual(sec["neigh"], neigh / 200, places=15)
+            self.assertAlmostEqual(sec["rest"], (total - pair - neigh) / 200, places=15)
+
+    def test_a_failed_run_is_named(self):
+        with self.assertRaises(SystemExit) as e:
+            self.peers.read_peer_log(self.log("lammps_n1000_bed_r0.out", "ERROR: Cannot open file bed.data\n"))
+        self.assertIn("lammps_n1000_bed_r0.out", str(e.exception))
+
+    def test_phase_table_sums_predict_and_correct_per_repetition_then_takes_the_median(self):
+        import pandas as pd
+        rows = []
+        for rep, (predict, correct, forces) in enumerate([(1e-5, 1e-6, 4e-5), (2e-5, 3e-6, 5e-5), (3e-5, 2e-6, 6e-5)]):
+            for phase, t in (("predict", predict), ("search", 0.0), ("forces", forces), ("correct", correct),
+                             ("total", predict + correct + forces)):
+                rows.append({"code": "suite", "variant": "fast", "particles": 1000, "stage": "bed", "repetition": rep,
+                             "steps": 200, "phase": phase, "seconds_per_step": t})
+            for phase, t in (("pair", 8e-5), ("neigh", 1e-6), ("rest", 2e-5), ("total", 1.01e-4)):
+                rows.append({"code": "lammps", "variant": "lammps", "particles": 1000, "stage": "bed", "repetition": rep,
+                             "steps": 200, "phase": phase, "seconds_per_step": t})
+        versions = {"lammps": "test", "lammps_package": "test"}
+        self.peers.write_bench(pd.DataFrame(rows), {}, versions, self.work, os.path.join(self.work, "f.png"))
+        text = open(os.path.join(self.work, "bench_peers.md")).read()
+        cells = {line.split("|")[1].strip() + "/" + line.split("|")[2].strip().split(" ")[0]: line.split("|")[3].strip()
+                 for line in text.split("## Where the time goes")[1].splitlines() if line.startswith("| fast") or line.startswith("| lammps")}
+        # per repetition 0.011, 0.023, 0.032 µs per particle-step: the median is 0.023 (not 0.02 + 0.002)
+        self.assertEqual(cells["fast/predict"], "0.0230")
+        self.assertEqual(cells["fast/forces"], "0.0500")
+        self.assertEqual(cells["lammps/Pair"], "0.0800")
+        self.assertEqual(cells["lammps/the"], "0.0200")
+        ratio = [line for line in text.splitlines() if line.startswith("| fast |")][0].split("|")[2].strip()
+        self.assertEqual(ratio, f"{(2e-5 + 3e-6 + 5e-5) / 1.01e-4:.2f}")  # totals only in the ratio table
+
+
 class OneN(unittest.TestCase):
     def test_no_curve_against_n_from_one_n(self):
         """The sample has one N: scaling and where-the-time-goes are tables, and a stale figure goes."""
