@@ -41,9 +41,8 @@ STAGE_TITLE = {"loose": "loose grid (t = 0)", "bed": "settled bed", "compression
 SUITE_PHASES = ["predict", "search", "forces", "correct"]
 PEER_PHASES = ["pair", "neigh", "rest"]
 # The phases side by side (write_bench's table): what each code times, in the order of a step.
-PHASE_TITLE = {"predict": "predict + correct (Gear pass, records, wall listing)", "search": "search (list rebuilds)",
-               "forces": "forces (pairs, walls, sums)", "pair": "Pair (the pair style)", "neigh": "Neigh (list rebuilds)",
-               "rest": "the rest (fixes: integration, gravity, walls; other)"}
+PHASE_TITLE = {"predict": "predict + correct (Gear)", "search": "search (cells, lists)", "forces": "forces (pairs, walls)",
+               "pair": "Pair (pair style)", "neigh": "Neigh (lists)", "rest": "rest (fixes: integration, gravity, walls; other)"}
 PEER_LOG = re.compile(r"^(lammps|liggghts)_n(\d+)_(.+)_r(\d+)\.out$")
 
 
