@@ -175,18 +175,24 @@ public:
         constexpr Bits flip_force = {0, 0, 0, kSign, kSign, kSign, 0, 0};
         const char* as_j = reinterpret_cast<const char*>(ring) + kTorqueJ * sizeof(double);
         const char* as_i = reinterpret_cast<const char*>(ring) + kForce * sizeof(double);
-        auto load = [](const char* at) {
-            Eight v;
-            std::memcpy(&v, at, sizeof(v));
-            return v;
-        };
+        // Through a reference, not a return value: a returned vector of 64 bytes has its own ABI
+        // without AVX-512 (GCC's -Wpsabi), though the call is always inlined.
+        auto load = [](Eight& v, const char* at) { std::memcpy(&v, at, sizeof(v)); };
         const std::uint32_t* row = from.table.data() + g.table;
         Eight sum[kGroup]{};
         for (std::int32_t e = 0; e < g.as_j; ++e, row += kGroup)
-            for (int l = 0; l < kGroup; ++l) sum[l] += Eight(Bits(load(as_j + row[l])) ^ flip_force);
+            for (int l = 0; l < kGroup; ++l) {
+                Eight v;
+                load(v, as_j + row[l]);
+                sum[l] += Eight(Bits(v) ^ flip_force);
+            }
         for (int l = 0; l < kGroup; ++l) sum[l] = __builtin_shufflevector(sum[l], sum[l], 3, 4, 5, 0, 1, 2, 6, 7);
         for (std::int32_t e = 0; e < g.as_i; ++e, row += kGroup)
-            for (int l = 0; l < kGroup; ++l) sum[l] += load(as_i + row[l]);
+            for (int l = 0; l < kGroup; ++l) {
+                Eight v;
+                load(v, as_i + row[l]);
+                sum[l] += v;
+            }
         for (int l = 0; l < g.count; ++l) {
             const std::size_t s = std::size_t(g.grain[l]);
             Quad f = __builtin_shufflevector(sum[l], sum[l], 0, 1, 2, 6), tq = __builtin_shufflevector(sum[l], sum[l], 3, 4, 5, 7);
