@@ -163,11 +163,24 @@ public:
     // is never -0, and x + ±0 = x for every other x), so each particle's bits are those of sum_particle
     // (the same order, kept there for the sums that read two rings or the list of all slots, which the
     // tables' ring offsets cannot name).
-    // A particle's force and torque are one vector of eight lanes, and each slot it reads one load of
-    // eight values: t_j and f as j (lanes: torque, then force, each added with the force's sign
-    // flipped, which is x - f bit for bit), f and t_i as i (force, then torque; the sum's lanes are
-    // swapped between the two). The last two lanes, the next values along, are not used.
+    // Where vectors have eight lanes (AVX-512) a particle's force and torque are one vector, and each
+    // slot it reads one load of eight values (sum_group_eight); narrower (AVX2), such a vector is two
+    // registers, and four sums with their inputs no longer fit the sixteen: GCC keeps them on the stack.
+    // There the force and the torque are a quad each (sum_group_quads), which fit. The same additions
+    // either way, lane by lane.
     void sum_group(const Schedule& from, const Group& g, const Slot* ring, const WallContacts& walls, Particles& p) const
+    {
+        if constexpr (kLanes >= 8)
+            sum_group_eight(from, g, ring, walls, p);
+        else
+            sum_group_quads(from, g, ring, walls, p);
+    }
+
+private:
+    // t_j and f as j (lanes: torque, then force, each added with the force's sign flipped, which is
+    // x - f bit for bit), f and t_i as i (force, then torque; the sum's lanes are swapped between the
+    // two). The last two lanes, the next values along, are not used.
+    void sum_group_eight(const Schedule& from, const Group& g, const Slot* ring, const WallContacts& walls, Particles& p) const
     {
         using Eight = Pack<double, 8>;
         using Bits = Pack<std::uint64_t, 8>;
@@ -201,6 +214,38 @@ public:
         }
     }
 
+    // The force and the torque a quad each, read as the quads that start at them in the slot (as
+    // sum_particle: the fourth lane, the next value along, is not used); as j the force is subtracted.
+    void sum_group_quads(const Schedule& from, const Group& g, const Slot* ring, const WallContacts& walls, Particles& p) const
+    {
+        const char* base = reinterpret_cast<const char*>(ring);
+        auto at = [base](std::uint32_t offset, std::size_t value) { return reinterpret_cast<const double*>(base + offset) + value; };
+        const std::uint32_t* row = from.table.data() + g.table;
+        Quad f[kGroup]{}, tq[kGroup]{};
+        for (std::int32_t e = 0; e < g.as_j; ++e, row += kGroup)
+            for (int l = 0; l < kGroup; ++l) {
+                Quad q;
+                load_quad(q, at(row[l], kForce));
+                f[l] -= q;
+                load_quad(q, at(row[l], kTorqueJ));
+                tq[l] += q;
+            }
+        for (std::int32_t e = 0; e < g.as_i; ++e, row += kGroup)
+            for (int l = 0; l < kGroup; ++l) {
+                Quad q;
+                load_quad(q, at(row[l], kForce));
+                f[l] += q;
+                load_quad(q, at(row[l], kTorqueI));
+                tq[l] += q;
+            }
+        for (int l = 0; l < g.count; ++l) {
+            const std::size_t s = std::size_t(g.grain[l]);
+            walls.add(s, f[l], tq[l]);
+            p.store_sum(s, f[l], tq[l]);
+        }
+    }
+
+public:
     std::size_t bytes() const
     {
         return heap_bytes(first_chunk, last_chunk, last_bucket_, first_bucket_) + by_last.bytes() + by_first.bytes();
