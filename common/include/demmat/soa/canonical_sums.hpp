@@ -176,7 +176,8 @@ public:
             sum_group_quads(from, g, ring, walls, p);
     }
 
-private:
+    // The two forms, public so that tests/test_canonical_sums.cpp runs both on any machine (a build
+    // runs only the one its target's width picks).
     // t_j and f as j (lanes: torque, then force, each added with the force's sign flipped, which is
     // x - f bit for bit), f and t_i as i (force, then torque; the sum's lanes are swapped between the
     // two). The last two lanes, the next values along, are not used.
@@ -245,7 +246,6 @@ private:
         }
     }
 
-public:
     std::size_t bytes() const
     {
         return heap_bytes(first_chunk, last_chunk, last_bucket_, first_bucket_) + by_last.bytes() + by_first.bytes();
