@@ -132,24 +132,11 @@ public:
         const double* lo = reinterpret_cast<const double*>(from.lo);
         const double* hi = reinterpret_cast<const double*>(from.hi);
         const std::size_t mask = from.mask, split = from.split;
-        auto at = [=](std::size_t k, std::size_t offset) { return (k < split ? lo : hi) + 9 * (k & mask) + offset; };
+        auto at = [=](std::size_t k) { return (k < split ? lo : hi) + 9 * (k & mask); };  // slot k
         const Index* as_j = list.as_j.data();
         Quad f{}, tq{};
-        for (Index e = list.jstart[s]; e < list.jstart[s + 1]; ++e) {
-            const std::size_t k = std::size_t(as_j[e]);
-            Quad q;
-            load_quad(q, at(k, kForce));
-            f -= q;
-            load_quad(q, at(k, kTorqueJ));
-            tq += q;
-        }
-        for (Index k = list.start[s]; k < list.start[s + 1]; ++k) {
-            Quad q;
-            load_quad(q, at(std::size_t(k), kForce));
-            f += q;
-            load_quad(q, at(std::size_t(k), kTorqueI));
-            tq += q;
-        }
+        for (Index e = list.jstart[s]; e < list.jstart[s + 1]; ++e) add_as_j(at(std::size_t(as_j[e])), f, tq);
+        for (Index k = list.start[s]; k < list.start[s + 1]; ++k) add_as_i(at(std::size_t(k)), f, tq);
         walls.add(s, f, tq);
         p.store_sum(s, f, tq);
     }
@@ -215,30 +202,17 @@ public:
         }
     }
 
-    // The force and the torque a quad each, read as the quads that start at them in the slot (as
-    // sum_particle: the fourth lane, the next value along, is not used); as j the force is subtracted.
+    // The force and the torque a quad each, slot by slot as sum_particle adds them.
     void sum_group_quads(const Schedule& from, const Group& g, const Slot* ring, const WallContacts& walls, Particles& p) const
     {
         const char* base = reinterpret_cast<const char*>(ring);
-        auto at = [base](std::uint32_t offset, std::size_t value) { return reinterpret_cast<const double*>(base + offset) + value; };
+        auto slot = [base](std::uint32_t offset) { return reinterpret_cast<const double*>(base + offset); };
         const std::uint32_t* row = from.table.data() + g.table;
         Quad f[kGroup]{}, tq[kGroup]{};
         for (std::int32_t e = 0; e < g.as_j; ++e, row += kGroup)
-            for (int l = 0; l < kGroup; ++l) {
-                Quad q;
-                load_quad(q, at(row[l], kForce));
-                f[l] -= q;
-                load_quad(q, at(row[l], kTorqueJ));
-                tq[l] += q;
-            }
+            for (int l = 0; l < kGroup; ++l) add_as_j(slot(row[l]), f[l], tq[l]);
         for (std::int32_t e = 0; e < g.as_i; ++e, row += kGroup)
-            for (int l = 0; l < kGroup; ++l) {
-                Quad q;
-                load_quad(q, at(row[l], kForce));
-                f[l] += q;
-                load_quad(q, at(row[l], kTorqueI));
-                tq[l] += q;
-            }
+            for (int l = 0; l < kGroup; ++l) add_as_i(slot(row[l]), f[l], tq[l]);
         for (int l = 0; l < g.count; ++l) {
             const std::size_t s = std::size_t(g.grain[l]);
             walls.add(s, f[l], tq[l]);
@@ -252,6 +226,26 @@ public:
     }
 
 private:
+    // One slot (its nine values from `slot`) into a particle's force and torque as quads, read as the
+    // quads that start at each vector (the fourth lane, the next value along, is not used): as j, the
+    // force subtracted and t_j added; as i, the force and t_i added.
+    [[gnu::always_inline]] static void add_as_j(const double* slot, Quad& f, Quad& tq)
+    {
+        Quad q;
+        load_quad(q, slot + kForce);
+        f -= q;
+        load_quad(q, slot + kTorqueJ);
+        tq += q;
+    }
+    [[gnu::always_inline]] static void add_as_i(const double* slot, Quad& f, Quad& tq)
+    {
+        Quad q;
+        load_quad(q, slot + kForce);
+        f += q;
+        load_quad(q, slot + kTorqueI);
+        tq += q;
+    }
+
     // The schedule of the particles by chunk[s]: each chunk's particles (order[start[c] … start[c + 1]),
     // sorted by their counts of slots as j, so that a group's lists are near one length), kGroup particles
     // a group, and their tables: a row of ring offsets a step, the lists as j to the group's longest,
