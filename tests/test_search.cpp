@@ -3,6 +3,7 @@
 // takes every pair (O(N²)) and sums in the canonical order; the contact counts must match too.
 #include <algorithm>
 #include <cmath>
+#include <random>
 
 #include <gtest/gtest.h>
 
@@ -123,3 +124,42 @@ INSTANTIATE_TEST_SUITE_P(AllVariants, Search,
                          [](const auto& info) {
                              return param_name(std::get<0>(info.param)) + "_" + kPackings[std::get<1>(info.param)].name;
                          });
+
+// The reference's own cell list (the health checks' and the counts' contact set at any N) against its
+// brute force: polydisperse clouds spanning negative and positive cells, pairs placed at exactly the
+// sum of their radii (h = 0 is no contact) and a hair inside it, a particle far out (its cell clamped),
+// and a NaN position (it touches nothing).
+TEST(ReferenceContactPairs, CellListFindsExactlyTheBruteForcePairs)
+{
+    for (std::uint64_t seed : {1u, 2u, 3u}) {
+        std::mt19937_64 rng(seed);
+        std::uniform_real_distribution<double> pos(-0.05, 0.05), rad(0.002, 0.008), unit(0.0, 1.0);
+        std::vector<Vec3d> x;
+        std::vector<double> r;
+        for (int k = 0; k < 1500; ++k) {
+            x.push_back({pos(rng), pos(rng), pos(rng)});
+            r.push_back(rad(rng));
+        }
+        for (int k = 0; k < 40; ++k) {  // touching exactly, and a hair inside, across cell edges
+            const Vec3d a{pos(rng), pos(rng), pos(rng)};
+            const double ra = rad(rng), rb = rad(rng);
+            const Vec3d v{unit(rng) - 0.5, unit(rng) - 0.5, unit(rng) - 0.5};
+            const Vec3d dir = v / std::sqrt(dot(v, v));
+            const double d = (k % 2 == 0) ? ra + rb : (ra + rb) * (1.0 - 1e-12);
+            x.push_back(a);
+            r.push_back(ra);
+            x.push_back(a + d * dir);
+            r.push_back(rb);
+        }
+        x.push_back({1e300, -1e300, 0.0});
+        r.push_back(0.005);
+        x.push_back({1e300, -1e300, 0.001});  // touches the one before, both clamped into one cell
+        r.push_back(0.005);
+        x.push_back({std::nan(""), 0.0, 0.0});
+        r.push_back(0.005);
+        const auto brute = contact_pairs(x, r, true);
+        const auto cells = contact_pairs(x, r, false);
+        ASSERT_GT(brute.size(), x.size());
+        EXPECT_EQ(cells, brute) << "seed " << seed;
+    }
+}

@@ -28,31 +28,63 @@ std::vector<Pair> contact_pairs(const std::vector<Vec3d>& x, const std::vector<d
                 if (law_says_contact(x[i], x[j], radius[i], radius[j])) out.emplace_back(i, j);
         return out;
     }
-    // Sorted cell list: cells of 2·R_max keyed by integer coordinates, looked up by binary search, so
-    // memory does not depend on the extent of the domain.
+    // A sorted cell list: cells of 2·R_max keyed by integer coordinates, sorted lexicographically, so
+    // memory does not depend on the extent of the domain. The health checks run it on every interval
+    // of steps, at any N (10^7 on a GPU), so it is linear after the sort: home cells are visited in key
+    // order, and each of the nine neighbour rows (dx, dy) is found by a cursor that only moves forward.
     const double edge = 2.0 * *std::max_element(radius.begin(), radius.end());
-    using Key = std::array<std::int64_t, 3>;
-    std::vector<std::pair<Key, std::int64_t>> cells;
-    cells.resize(std::size_t(n));
-    for (std::int64_t i = 0; i < n; ++i)
-        cells[i] = {{std::int64_t(std::floor(x[i].x / edge)), std::int64_t(std::floor(x[i].y / edge)),
-                     std::int64_t(std::floor(x[i].z / edge))}, i};
-    std::sort(cells.begin(), cells.end());
+    struct Item {
+        std::array<std::int64_t, 3> cell;
+        std::int64_t id;
+    };
+    // Clamped far out, so that any finite position has a cell: clamped particles share a cell and are
+    // tested exactly, which keeps the set a superset. A NaN coordinate touches nothing (h > 0 is false).
+    constexpr double kFar = 4.0e18;
+    auto cell_of = [&](double c) { return std::int64_t(std::clamp(std::floor(c / edge), -kFar, kFar)); };
+    std::vector<Item> items;
+    items.reserve(std::size_t(n));
     for (std::int64_t i = 0; i < n; ++i) {
-        const Key k{std::int64_t(std::floor(x[i].x / edge)), std::int64_t(std::floor(x[i].y / edge)),
-                    std::int64_t(std::floor(x[i].z / edge))};
-        for (std::int64_t dx = -1; dx <= 1; ++dx)
-            for (std::int64_t dy = -1; dy <= 1; ++dy)
-                for (std::int64_t dz = -1; dz <= 1; ++dz) {
-                    const Key q{k[0] + dx, k[1] + dy, k[2] + dz};
-                    auto it = std::lower_bound(cells.begin(), cells.end(), std::make_pair(q, std::int64_t(-1)));
-                    for (; it != cells.end() && it->first == q; ++it) {
-                        const std::int64_t j = it->second;
-                        if (j > i && law_says_contact(x[i], x[j], radius[i], radius[j])) out.emplace_back(i, j);
-                    }
-                }
+        const Vec3d& p = x[i];
+        if (std::isnan(p.x) || std::isnan(p.y) || std::isnan(p.z)) continue;
+        items.push_back({{cell_of(p.x), cell_of(p.y), cell_of(p.z)}, i});
     }
-    std::sort(out.begin(), out.end());
+    std::sort(items.begin(), items.end(), [](const Item& a, const Item& b) { return a.cell < b.cell; });
+    const std::size_t m = items.size();
+    std::array<std::size_t, 9> cursor{};  // per row (dx, dy): the first item not below the row's start
+    std::vector<std::int64_t> count(std::size_t(n) + 1, 0);
+    std::vector<Pair> found;
+    for (std::size_t a = 0; a < m;) {
+        const auto home = items[a].cell;
+        std::size_t b = a;
+        while (b < m && items[b].cell == home) ++b;
+        int row = 0;
+        for (std::int64_t dx = -1; dx <= 1; ++dx)
+            for (std::int64_t dy = -1; dy <= 1; ++dy, ++row) {
+                const std::array<std::int64_t, 3> lo{home[0] + dx, home[1] + dy, home[2] - 1};
+                const std::array<std::int64_t, 3> hi{home[0] + dx, home[1] + dy, home[2] + 1};
+                std::size_t& c = cursor[std::size_t(row)];
+                while (c < m && items[c].cell < lo) ++c;
+                for (std::size_t q = c; q < m && items[q].cell <= hi; ++q)
+                    for (std::size_t p = a; p < b; ++p) {
+                        const std::int64_t i = items[p].id, j = items[q].id;
+                        if (j > i && law_says_contact(x[i], x[j], radius[i], radius[j])) {
+                            found.emplace_back(i, j);
+                            ++count[std::size_t(i) + 1];
+                        }
+                    }
+            }
+        a = b;
+    }
+    // Sorted by (i, j): a counting sort by i, then each particle's few partners.
+    for (std::size_t i = 0; i < std::size_t(n); ++i) count[i + 1] += count[i];
+    out.resize(found.size());
+    for (const Pair& pr : found) out[std::size_t(count[std::size_t(pr.first)]++)] = pr;
+    for (auto it = out.begin(); it != out.end();) {
+        auto e = it;
+        while (e != out.end() && e->first == it->first) ++e;
+        std::sort(it, e);
+        it = e;
+    }
     return out;
 }
 
