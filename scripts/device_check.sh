@@ -6,15 +6,15 @@
 #   scripts/device_check.sh             on the GPU machine, from the repository root, with build-gpu/dist/
 #                                       carried there: provenance, the bitwise comparisons, the benchmark
 #
-# The run writes results/gpu/ (and copies it under $OUT when $OUT is set): nvidia-smi, the code the
+# The run writes results/gpu/ (and archives it under $OUT when $OUT is set): nvidia-smi, the code the
 # binary carries, `demmat compare` of cuda against arrays (dense bed and compression stage, 1000 steps),
 # and `demmat bench` of cuda beside fast at 16 threads and at 1 on dense beds of 10^4, 10^5 and 10^6
 # grains settled on the device, and on the loose lattice of 10^7. It keeps to a time budget (BUDGET_S,
 # default 450 s): a stage that no longer fits is skipped and says so in results/gpu/log.txt.
 # Knobs: BUDGET_S, SETTLE_TIME (simulated seconds of settling, default 0.15: the 12-layer bed has
 # collapsed by then), SIZES (default "10000 100000 1000000"), BIG (default 10000000; 0 skips it),
-# CMP_N and CMP_STEPS (the comparisons' bed and length, default 2000 and 1000), RESULTS (default
-# results/gpu). VARIANT=cuda_host runs the whole flow on the CPU, to try the script without a GPU.
+# CMP_N and CMP_STEPS (the comparisons' bed and length, default 2000 and 1000), CHECK_EVERY (steps
+# between the health checks of a settle, default 1500), RESULTS (default results/gpu). VARIANT=cuda_host runs the whole flow on the CPU, to try the script without a GPU.
 # Usage: scripts/device_check.sh [--pack] [--build-dir DIR]
 #   --pack           on the build machine: build DIR and pack DIR/dist for the GPU machine
 #   --build-dir DIR  the portable build folder (default build-gpu); its dist/ is what travels
@@ -105,7 +105,10 @@ run_capped() {
 }
 finish() {
   say "== done in $((SECONDS - start)) s"
-  if [[ -n "${OUT:-}" ]]; then mkdir -p "$OUT/results" && cp -r "$res" "$OUT/results/" && rm -rf "$OUT/results/$(basename "$res")/work"; fi
+  # The lent machines return at most 8 files: the results as one archive (without the work files), the log beside it.
+  if [[ -n "${OUT:-}" ]]; then
+    tar -C "$(dirname "$res")" --exclude=work -czf "$OUT/gpu-results.tar.gz" "$(basename "$res")" && cp "$log" "$OUT/log.txt"
+  fi
 }
 trap finish EXIT
 
@@ -134,10 +137,18 @@ fi
 "${demmat[@]}" list | tee "$res/list.txt" | tee -a "$log"
 if ! grep -E "^$gpu " "$res/list.txt" | grep -qv unavailable; then say "error: the $gpu variant cannot run here (see list.txt)"; exit 1; fi
 
+# A settle on the device checks its health every CHECK_EVERY steps (default 1500), not the scene's 100:
+# each check reads the whole state back and finds its contacts on one CPU core, which at 10^6 grains
+# would take longer than the steps between the checks.
+check_every=${CHECK_EVERY:-1500}
+device_scene() {  # device_scene N FILE: the dense bed of N grains, checked every check_every steps
+  "${demmat[@]}" scene dense-bed --n "$1" -o "$2" && sed -i "s/^interval = .*/interval = $check_every/" "$2"
+}
+
 cmp_steps=${CMP_STEPS:-1000}
 say "== bitwise: $gpu against arrays (and a second $gpu run), $cmp_steps steps"
 n=${CMP_N:-2000}
-"${demmat[@]}" scene dense-bed --n "$n" -o "$work/bed_$n.toml"
+device_scene "$n" "$work/bed_$n.toml"
 run_capped 120 "${demmat[@]}" run "$work/bed_$n.toml" --variant "$gpu" --time "$settle_time" --save "$work/bed_${n}_settled.state" -q \
   --json "$res/settle_$n.json" >> "$log" 2>&1
 "${demmat[@]}" scene compression --from "$work/bed_$n.toml" --state "$work/bed_${n}_settled.state" -o "$work/bed_${n}_compression.toml"
@@ -159,7 +170,7 @@ bench() {
   done
 }
 for n in $sizes; do
-  "${demmat[@]}" scene dense-bed --n "$n" -o "$work/bed_$n.toml"
+  device_scene "$n" "$work/bed_$n.toml"
   run_capped 200 "${demmat[@]}" run "$work/bed_$n.toml" --variant "$gpu" --time "$settle_time" --save "$work/bed_${n}_settled.state" -q \
     --json "$res/settle_$n.json" >> "$log" 2>&1 || continue
   "${demmat[@]}" scene settled --from "$work/bed_$n.toml" --state "$work/bed_${n}_settled.state" -o "$work/bed_${n}_settled.toml"
