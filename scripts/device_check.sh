@@ -15,15 +15,19 @@
 # collapsed by then), SIZES (default "10000 100000 1000000"), BIG (default 10000000; 0 skips it),
 # CMP_N and CMP_STEPS (the comparisons' bed and length, default 2000 and 1000), CHECK_EVERY (steps
 # between the health checks of a settle, default 1500), RESULTS (default results/gpu). VARIANT=cuda_host runs the whole flow on the CPU, to try the script without a GPU.
-# Usage: scripts/device_check.sh [--pack] [--build-dir DIR]
-#   --pack           on the build machine: build DIR and pack DIR/dist for the GPU machine
-#   --build-dir DIR  the portable build folder (default build-gpu); its dist/ is what travels
+# Usage: scripts/device_check.sh [--pack [--fast-arch ARCH]] [--build-dir DIR]
+#   --pack            on the build machine: build DIR and pack DIR/dist for the GPU machine
+#   --fast-arch ARCH  with --pack: compile fast for the GPU machine's CPU (GCC's -march=ARCH, e.g.
+#                     x86-64-v4 for AVX-512) as its own build does with native; default: portable code
+#   --build-dir DIR   the build folder (default build-gpu); its dist/ is what travels
 source "$(dirname "$0")/lib.sh"
 BUILD_DIR=${DEMMAT_BUILD_DIR:-build-gpu}
 pack=false
+fast_arch=""
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --pack) pack=true; shift ;;
+    --fast-arch) need_value "$@"; fast_arch=$2; shift 2 ;;
     *) shared_option "$@"; shift "$SHIFT" ;;
   esac
 done
@@ -33,8 +37,10 @@ dist=$BUILD_DIR/dist
 
 if $pack; then
   set -e
-  # Portable code for an unknown host CPU: fast without -march=native (bit-identical either way).
-  cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release -DDEMMAT_FAST_NATIVE=OFF -DDEMMAT_BUILD_BENCH=OFF \
+  # Portable code for an unknown host CPU (fast without -march), or fast for the CPU named by --fast-arch;
+  # bit-identical either way.
+  if [[ -n "$fast_arch" ]]; then fast=(-DDEMMAT_FAST_NATIVE=ON "-DDEMMAT_FAST_ARCH=$fast_arch"); else fast=(-DDEMMAT_FAST_NATIVE=OFF); fi
+  cmake -S . -B "$BUILD_DIR" -DCMAKE_BUILD_TYPE=Release "${fast[@]}" -DDEMMAT_BUILD_BENCH=OFF \
         -DCMAKE_EXE_LINKER_FLAGS="-static-libstdc++ -static-libgcc" ${CCACHE_DIR:+-DCMAKE_CXX_COMPILER_LAUNCHER=ccache} >/dev/null
   cmake --build "$BUILD_DIR" -j"${JOBS:-2}" --target demmat
   rm -rf "$dist" && mkdir -p "$dist/bin" "$dist/lib" "$dist/glibc"
@@ -54,6 +60,7 @@ if $pack; then
     for f in "$dist"/bin/* "$dist"/lib/*; do objdump -T "$f" 2>/dev/null; done | grep -o 'GLIBC_[0-9.]*' | sort -Vu | tail -1
     grep -h 'set(CMAKE_CUDA_COMPILER_VERSION' $BUILD_DIR/CMakeFiles/*/CMakeCUDACompiler.cmake 2>/dev/null | head -1
     grep -h '^CUDA_FLAGS' $BUILD_DIR/variants/CMakeFiles/demmat_variant_cuda.dir/flags.make || echo "no cuda variant in this build"
+    echo "fast compiled with: $(grep -h '^CXX_FLAGS' $BUILD_DIR/variants/CMakeFiles/demmat_variant_fast.dir/flags.make | cut -d= -f2-)"
   } > "$dist/build-info.txt"
   # The device code's arithmetic, checked here (cuobjdump is not on this machine): the PTX of cuda.cu
   # with the build's flags has no fused multiply-add, and every f64 add, mul, div and sqrt rounds to nearest.
