@@ -187,6 +187,9 @@ def build(root, out, paper):
             "the mpi benchmark, halo traffic and imbalance", "scripts/run_mpi_bench.sh")
     if os.path.exists(rep.path("mpi/scaling.md")):
         rep.add(f"The scaling model from these measurements: {rep.link('mpi/scaling.md')}.", "")
+    section(rep, "The GPU style: the cuda variant", ["gpu/summary.md"], [],
+            "the cuda variant's check on a GPU (bit for bit against arrays, µs per particle-step beside fast)",
+            "scripts/device_check.sh --pack here, then scripts/device_check.sh on a GPU machine, then analysis/summarise_gpu.py results/gpu")
     section(rep, "Accuracy: error against time step and CPU time", ["accuracy/recommendation.md"],
             [("figures/accuracy_work_precision.png", "work–precision"), ("figures/accuracy_error_vs_dt.png", "error against Δt")],
             "the speed–accuracy study", "scripts/run_accuracy.sh")

@@ -1,0 +1,127 @@
+#!/usr/bin/python3
+"""The GPU device check (scripts/device_check.sh) as tables: whether cuda was bit-identical to arrays,
+and µs per particle-step of cuda, fast on every core and fast on one, per bed and N, with cuda's
+speed-up over each and its phases; the GPU, its driver and the host CPU the run found.
+
+Usage: /usr/bin/python3 analysis/summarise_gpu.py results/gpu [-o results/gpu/summary.md]
+"""
+import argparse
+import pathlib
+import re
+import sys
+
+from atomic_io import write_text
+import results
+
+GPU_VARIANTS = ("cuda", "cuda_host")
+
+
+def read(folder):
+    """One row per bench_<state>_<N>_<variant>_<threads>.json: its median and min–max µs per
+    particle-step, its phases' shares, contacts and bytes per particle."""
+    rows, prov = [], {}
+    for path in sorted(folder.glob("bench_*.json")):
+        m = re.fullmatch(r"bench_(settled|loose)_(\d+)_([a-z_]+)_(\d+)\.json", path.name)
+        if not m:
+            continue
+        res = results.load(str(path))
+        d = res.meta
+        n = d["scene"]["particles"]
+        for s in d["summary"]:
+            sec = s["seconds_per_step"]
+            total = sec["total"]["median"]
+            rows.append({"state": m.group(1), "N": n, "variant": s["variant"],
+                         "threads": int(s.get("threads_asked", s["threads"])), "ran_on": int(s["threads"]),
+                         "us": s["us_per_particle_step"],
+                         "min_us": sec["total"]["min"] / n * 1e6, "max_us": sec["total"]["max"] / n * 1e6,
+                         **{p: 100.0 * sec[p]["median"] / total for p in results.PHASES},
+                         "contacts": s["contacts_per_particle"], "bytes": s["memory_bytes"] / n,
+                         "steps": d["steps"], "repetitions": d["repetitions"]})
+        prov[path.name] = res.provenance
+    return rows, prov
+
+
+def comparisons(folder):
+    """Each compare_<scene>.txt's verdict line (demmat compare prints 'identical: ...' or where the first
+    difference is)."""
+    out = []
+    for path in sorted(folder.glob("compare_*.txt")):
+        lines = [l.strip() for l in path.read_text().splitlines() if l.strip()]
+        out.append((path.stem.removeprefix("compare_"), lines[-1] if lines else "(no output: the compare did not run)"))
+    return out
+
+
+def device_line(folder):
+    """The GPU, driver and compute capability (nvidia-smi's CSV in log.txt) and the host CPU (host.txt)."""
+    gpu = ""
+    log = folder / "log.txt"
+    if log.exists():
+        text = log.read_text().splitlines()
+        for k, line in enumerate(text):
+            if line.startswith("name, driver_version") and k + 1 < len(text):
+                name, driver, cap, mem = (x.strip() for x in (text[k + 1].split(",") + ["", "", "", ""])[:4])
+                gpu = f"GPU {name}, driver {driver}, compute capability {cap}, {mem}"
+    cpu = ""
+    host = folder / "host.txt"
+    if host.exists():
+        t = host.read_text()
+        model = re.search(r"Model name:\s*(.+)", t)
+        lines = t.splitlines()
+        cores = lines[2].strip() if len(lines) > 2 and lines[2].strip().isdigit() else "?"
+        cpu = f"host CPU {model.group(1).strip() if model else 'unknown'} ({cores} logical CPUs)"
+    return "; ".join(x for x in (gpu, cpu) if x)
+
+
+def table(rows):
+    """Per (state, N): each configuration's line, cuda's speed-ups over fast at 1 thread and at the most."""
+    out = ["| bed | N | variant | threads | µs/particle-step | min–max | cuda's speed-up over it | predict | search | forces | correct "
+           "| contacts/particle | bytes/particle | steps × repetitions |",
+           "|---|---:|---|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---|"]
+    order = {"settled": 0, "loose": 1}
+    rows = sorted(rows, key=lambda r: (order[r["state"]], r["N"], r["variant"] not in GPU_VARIANTS, r["variant"], -r["threads"]))
+    for r in rows:
+        gpu = [g for g in rows if g["state"] == r["state"] and g["N"] == r["N"] and g["variant"] in GPU_VARIANTS]
+        speedup = f"{r['us'] / gpu[0]['us']:.1f}×" if gpu and r["variant"] not in GPU_VARIANTS else ""
+        threads = f"{r['threads']}" + (f" (ran on {r['ran_on']})" if r["ran_on"] != r["threads"] else "")
+        out.append(f"| {r['state']} | {r['N']} | {r['variant']} | {threads} | {r['us']:.4f} | {r['min_us']:.4f}–{r['max_us']:.4f} | {speedup} "
+                   f"| {r['predict']:.0f} % | {r['search']:.0f} % | {r['forces']:.0f} % | {r['correct']:.0f} % | {r['contacts']:.2f} "
+                   f"| {r['bytes']:.0f} | {r['steps']} × {r['repetitions']} |")
+    return out
+
+
+def main(argv):
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("folder", type=pathlib.Path)
+    ap.add_argument("-o", "--output", type=pathlib.Path)
+    a = ap.parse_args(argv)
+    rows, prov = read(a.folder)
+    cmp = comparisons(a.folder)
+    if not rows and not cmp:
+        print(f"summarise_gpu.py: no bench_*.json or compare_*.txt in {a.folder}", file=sys.stderr)
+        return 1
+    p = next(iter(prov.values()), {})
+    out = ["# The cuda variant on a GPU", "",
+           "Produced by scripts/device_check.sh on a lent GPU machine and analysis/summarise_gpu.py. "
+           + device_line(a.folder) + ". "
+           + (f"Built here and carried: commit {p.get('commit', '?')[:10]}{' (dirty)' if p.get('dirty') else ''}, {p.get('compiler', '?')}, "
+              f"`{p.get('flags', '?')}` (the CUDA flags: build-info.txt; the PTX check: ptx-check.txt), run {p.get('date', '?')}." if p else ""),
+           "", "## Bit for bit against arrays", "",
+           "`demmat compare --variants cuda,arrays,cuda`: the dense bed settling from its loose lattice, and its compression "
+           "stage (a moving wall) from the state settled on the device; the second cuda run checks that the device repeats itself.", ""]
+    out += [f"- {scene}: {verdict}" for scene, verdict in cmp] or ["- no comparison ran (log.txt says why)"]
+    if rows:
+        out += ["", "## Time per particle-step", "",
+                "Median µs per particle-step over the repetitions (min–max), each configuration its own `demmat bench`; phases as % "
+                "of the step, each phase timed after the device has finished it (docs/cuda.md, Timing). *settled*: the dense bed "
+                "settled on the device, continued with its walls at rest; *loose*: the bed's loose lattice at t = 0. "
+                "cuda's speed-up is the configuration's median over cuda's.", ""]
+        out += table(rows)
+    text = "\n".join(out) + "\n"
+    if a.output:
+        write_text(str(a.output), text)
+    print(text)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main(sys.argv[1:]))
