@@ -126,6 +126,41 @@ class Loader(unittest.TestCase):
         us = {x["variant"]: x["us_per_particle_step"] for x in raw["summary"]}
         self.assertEqual(row[0].split("|")[4].strip(), f"{us['fast'] / us['fast_unordered']:.3f}")
 
+    def test_summarise_gpu_speed_up_over_cuda_and_the_verdicts(self):
+        # the sample's arrays as cuda and its fast as fast at 2 threads, each in its own file as
+        # device_check.sh writes them: fast's row carries its median over cuda's, and each compare's
+        # last line is quoted, a difference as well as an identity
+        import json
+        raw = json.load(open(os.path.join(DATA, "bench_sample.json")))
+        work = tempfile.mkdtemp()
+        try:
+            us = {}
+            for v, name in (("arrays", "cuda"), ("fast", "fast")):
+                one = json.loads(json.dumps(raw))
+                one["samples"] = [dict(x, variant=name) for x in one["samples"] if x["variant"] == v]
+                one["summary"] = [dict(x, variant=name) for x in one["summary"] if x["variant"] == v]
+                us[name] = one["summary"][0]["us_per_particle_step"]
+                threads = one["summary"][0]["threads"]
+                with open(os.path.join(work, f"bench_settled_2000_{name}_{threads}.json"), "w") as f:
+                    json.dump(one, f)
+            with open(os.path.join(work, "compare_bed_2000.txt"), "w") as f:
+                f.write("identical: cuda, arrays, cuda over 1000 steps of 'dense_bed_2000' (2000 particles)\n")
+            with open(os.path.join(work, "compare_bed_2000_compression.txt"), "w") as f:
+                f.write("step 1\nfirst difference: step 3, particle 7, position x\n")
+            out = os.path.join(work, "summary.md")
+            subprocess.run([sys.executable, os.path.join(ANALYSIS, "summarise_gpu.py"), work, "-o", out], check=True,
+                           stdout=subprocess.DEVNULL)
+            text = open(out).read()
+        finally:
+            shutil.rmtree(work)
+        self.assertIn("- bed_2000: identical: cuda, arrays, cuda over 1000 steps", text)
+        self.assertIn("- bed_2000_compression: first difference: step 3, particle 7, position x", text)
+        rows = {line.split("|")[3].strip(): line.split("|") for line in text.splitlines() if line.startswith("| settled | 2000 |")}
+        self.assertEqual(set(rows), {"cuda", "fast"})
+        self.assertEqual(rows["fast"][7].strip(), f"{us['fast'] / us['cuda']:.1f}×")
+        self.assertEqual(rows["cuda"][7].strip(), "")
+        self.assertEqual(rows["cuda"][5].strip(), f"{us['cuda']:.4f}")
+
     def test_google_benchmark(self):
         r = results.load(os.path.join(DATA, "gbench_sample.json"))
         self.assertEqual(r.kind, "gbench")
