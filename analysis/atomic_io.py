@@ -24,3 +24,10 @@ def write_text(path, text):
         with open(tmp, "w") as f:
             f.write(text)
     atomic_write(path, write)
+
+
+def emit(text, path=None):
+    """A summary's Markdown: written whole to path when one is given, and printed."""
+    if path:
+        write_text(str(path), text)
+    print(text)

@@ -209,6 +209,28 @@ def _gbench(path, raw):
     return Result("gbench", path, prov, table.reset_index(drop=True), meta)
 
 
+def summary_rows(res):
+    """One row per configuration of a `demmat bench` result (its "summary"): variant, the threads asked
+    (a variant may run a small bed on fewer: ran_on), the median and min–max µs per particle-step, each
+    phase's share of the step ("<phase> %"), contacts and bytes per particle, steps and repetitions."""
+    d = res.meta
+    n = d["scene"]["particles"]
+    rows = []
+    for s in d["summary"]:
+        sec = s["seconds_per_step"]
+        total = sec["total"]["median"]
+        rows.append({
+            "N": n, "variant": s["variant"],
+            "threads": int(s.get("threads_asked", s["threads"])), "ran_on": int(s["threads"]),
+            "us_per_particle_step": s["us_per_particle_step"],
+            "min_us": sec["total"]["min"] / n * 1e6, "max_us": sec["total"]["max"] / n * 1e6,
+            **{f"{p} %": 100.0 * sec[p]["median"] / total for p in PHASES},
+            "contacts/particle": s["contacts_per_particle"], "bytes/particle": s["memory_bytes"] / n,
+            "repetitions": d["repetitions"], "steps": d["steps"],
+        })
+    return rows
+
+
 def wide(table):
     """One row per sample: each phase a column `<phase>_s`, and their sum `total_s`."""
     timed = table.dropna(subset=["phase"])

@@ -13,7 +13,7 @@ import sys
 
 import pandas as pd
 
-from atomic_io import write_text
+from atomic_io import emit
 import results
 
 
@@ -41,23 +41,10 @@ def read(folder):
         if not m:
             continue
         res = results.load(str(path))
-        d = res.meta
         state, n = m.group(1), int(m.group(2))
         prov.setdefault(state, {})[n] = res.provenance
-        for s in d["summary"]:
-            sec = s["seconds_per_step"]
-            total = sec["total"]["median"]
-            rows.append({
-                # Rows by the threads asked: a variant may run a small bed on fewer (fast below 3000 grains).
-                "state": state, "N": n, "threads": int(s.get("threads_asked", s["threads"])), "ran_on": int(s["threads"]),
-                "variant": s["variant"],
-                "us_per_particle_step": s["us_per_particle_step"],
-                "min_us": sec["total"]["min"] / d["scene"]["particles"] * 1e6,
-                "max_us": sec["total"]["max"] / d["scene"]["particles"] * 1e6,
-                **{f"{p} %": 100.0 * sec[p]["median"] / total for p in ("predict", "search", "forces", "correct")},
-                "contacts/particle": s["contacts_per_particle"], "bytes/particle": s["memory_bytes"] / d["scene"]["particles"],
-                "repetitions": d["repetitions"], "steps": d["steps"],
-            })
+        # Rows by the threads asked: a variant may run a small bed on fewer (fast below 3000 grains).
+        rows += [dict(r, state=state) for r in results.summary_rows(res)]
         asked = "threads_asked" if "threads_asked" in res.table.columns else "threads"
         tot = res.table.groupby(["variant", asked, "repetition"])["seconds"].sum().unstack(asked)
         costs += canonical_cost(tot, state, n)
@@ -151,9 +138,7 @@ def main(argv):
             line += f"; peak resident set {int(rss.group(1)) / 1024 ** 2:.2f} GiB"
         out.append(line + ".")
     text = "\n".join(out) + "\n"
-    if a.output:
-        write_text(str(a.output), text)
-    print(text)
+    emit(text, a.output)
     return 0
 
 

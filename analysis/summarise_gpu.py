@@ -10,7 +10,7 @@ import pathlib
 import re
 import sys
 
-from atomic_io import write_text
+from atomic_io import emit
 import results
 
 GPU_VARIANTS = ("cuda", "cuda_host")
@@ -25,18 +25,7 @@ def read(folder):
         if not m:
             continue
         res = results.load(str(path))
-        d = res.meta
-        n = d["scene"]["particles"]
-        for s in d["summary"]:
-            sec = s["seconds_per_step"]
-            total = sec["total"]["median"]
-            rows.append({"state": m.group(1), "N": n, "variant": s["variant"],
-                         "threads": int(s.get("threads_asked", s["threads"])), "ran_on": int(s["threads"]),
-                         "us": s["us_per_particle_step"],
-                         "min_us": sec["total"]["min"] / n * 1e6, "max_us": sec["total"]["max"] / n * 1e6,
-                         **{p: 100.0 * sec[p]["median"] / total for p in results.PHASES},
-                         "contacts": s["contacts_per_particle"], "bytes": s["memory_bytes"] / n,
-                         "steps": d["steps"], "repetitions": d["repetitions"]})
+        rows += [dict(r, state=m.group(1)) for r in results.summary_rows(res)]
         prov[path.name] = res.provenance
     return rows, prov
 
@@ -81,11 +70,11 @@ def table(rows):
     rows = sorted(rows, key=lambda r: (order[r["state"]], r["N"], r["variant"] not in GPU_VARIANTS, r["variant"], -r["threads"]))
     for r in rows:
         gpu = [g for g in rows if g["state"] == r["state"] and g["N"] == r["N"] and g["variant"] in GPU_VARIANTS]
-        speedup = f"{r['us'] / gpu[0]['us']:.1f}×" if gpu and r["variant"] not in GPU_VARIANTS else ""
+        speedup = f"{r['us_per_particle_step'] / gpu[0]['us_per_particle_step']:.1f}×" if gpu and r["variant"] not in GPU_VARIANTS else ""
         threads = f"{r['threads']}" + (f" (ran on {r['ran_on']})" if r["ran_on"] != r["threads"] else "")
-        out.append(f"| {r['state']} | {r['N']} | {r['variant']} | {threads} | {r['us']:.4f} | {r['min_us']:.4f}–{r['max_us']:.4f} | {speedup} "
-                   f"| {r['predict']:.0f} % | {r['search']:.0f} % | {r['forces']:.0f} % | {r['correct']:.0f} % | {r['contacts']:.2f} "
-                   f"| {r['bytes']:.0f} | {r['steps']} × {r['repetitions']} |")
+        out.append(f"| {r['state']} | {r['N']} | {r['variant']} | {threads} | {r['us_per_particle_step']:.4f} | {r['min_us']:.4f}–{r['max_us']:.4f} | {speedup} "
+                   f"| {r['predict %']:.0f} % | {r['search %']:.0f} % | {r['forces %']:.0f} % | {r['correct %']:.0f} % | {r['contacts/particle']:.2f} "
+                   f"| {r['bytes/particle']:.0f} | {r['steps']} × {r['repetitions']} |")
     return out
 
 
@@ -117,9 +106,7 @@ def main(argv):
                 "cuda's speed-up is the configuration's median over cuda's.", ""]
         out += table(rows)
     text = "\n".join(out) + "\n"
-    if a.output:
-        write_text(str(a.output), text)
-    print(text)
+    emit(text, a.output)
     return 0
 
 
