@@ -173,13 +173,15 @@ def build(root, out, paper):
     section(rep, "Validation: the physics beside LAMMPS and LIGGGHTS", [physics],
             [(n and f"figures/peers_physics_{n}.png", "Physics cross-check")],
             "the ensemble cross-check of the physics against LAMMPS and LIGGGHTS", "scripts/run_peers.sh")
-    section(rep, "Beside LAMMPS with contact memory (tangential mindlin): time per step", ["peers_mindlin/bench_peers.md"],
-            [("peers_mindlin/peers_us_per_particle_step.png", "µs per particle-step against N, mindlin")],
-            "the benchmark beside LAMMPS with a law of physics.md §9", "scripts/run_peers.sh --contact \"tangential=mindlin ...\"")
-    physics_law = newest(root, "peers_mindlin/physics_*.md")
-    section(rep, "The physics beside LAMMPS with contact memory (tangential mindlin)", [physics_law],
-            [(physics_law and physics_law.replace("physics_", "peers_physics_").replace(".md", ".png"), "Physics cross-check, mindlin")],
-            "the ensemble cross-check with a law of physics.md §9", "scripts/run_peers.sh --contact \"tangential=mindlin ...\"")
+    for folder, law, keys in (("peers_mindlin", "tangential mindlin", "tangential=mindlin ..."),
+                              ("peers_mindlin_sds", "tangential mindlin, rolling sds", "tangential=mindlin ... rolling=sds ...")):
+        section(rep, f"Beside LAMMPS with contact memory ({law}): time per step", [f"{folder}/bench_peers.md"],
+                [(f"{folder}/peers_us_per_particle_step.png", f"µs per particle-step against N, {law}")],
+                "the benchmark beside LAMMPS with a law of physics.md §9", f"scripts/run_peers.sh --contact \"{keys}\" --out results/{folder}")
+        physics_law = newest(root, f"{folder}/physics_*.md")
+        section(rep, f"The physics beside LAMMPS with contact memory ({law})", [physics_law],
+                [(physics_law and physics_law.replace("physics_", "peers_physics_").replace(".md", ".png"), f"Physics cross-check, {law}")],
+                "the ensemble cross-check with a law of physics.md §9", f"scripts/run_peers.sh --contact \"{keys}\" --out results/{folder}")
     section(rep, "What contact memory costs each style", ["memory_cost/table.md"], [("memory_cost/memory_cost.png", "memory cost")],
             "the cost of contact memory per style", "scripts/run_memory_cost.sh")
     validation(rep)
