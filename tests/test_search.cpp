@@ -128,7 +128,7 @@ INSTANTIATE_TEST_SUITE_P(AllVariants, Search,
 // The reference's own cell list (the health checks' and the counts' contact set at any N) against its
 // brute force: polydisperse clouds spanning negative and positive cells, pairs placed at exactly the
 // sum of their radii (h = 0 is no contact) and a hair inside it, a particle far out (its cell clamped),
-// and a NaN position (it touches nothing).
+// a NaN position and a NaN radius (they touch nothing).
 TEST(ReferenceContactPairs, CellListFindsExactlyTheBruteForcePairs)
 {
     for (std::uint64_t seed : {1u, 2u, 3u}) {
@@ -157,9 +157,15 @@ TEST(ReferenceContactPairs, CellListFindsExactlyTheBruteForcePairs)
         r.push_back(0.005);
         x.push_back({std::nan(""), 0.0, 0.0});
         r.push_back(0.005);
+        // A NaN radius first, beside a grain: it touches nothing, and the cells' size comes from the others.
+        x.insert(x.begin(), x[5] + Vec3d{0.001, 0.0, 0.0});
+        r.insert(r.begin(), std::nan(""));
         const auto brute = contact_pairs(x, r, true);
         const auto cells = contact_pairs(x, r, false);
         ASSERT_GT(brute.size(), x.size());
         EXPECT_EQ(cells, brute) << "seed " << seed;
     }
+    // Radii of zero: no pair has h > 0.
+    const std::vector<Vec3d> x(100, Vec3d{0.01, 0.02, 0.03});
+    EXPECT_TRUE(contact_pairs(x, std::vector<double>(100, 0.0), false).empty());
 }

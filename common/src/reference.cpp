@@ -32,7 +32,10 @@ std::vector<Pair> contact_pairs(const std::vector<Vec3d>& x, const std::vector<d
     // memory does not depend on the extent of the domain. The health checks run it on every interval
     // of steps, at any N (10^7 on a GPU), so it is linear after the sort: home cells are visited in key
     // order, and each of the nine neighbour rows (dx, dy) is found by a cursor that only moves forward.
-    const double edge = 2.0 * *std::max_element(radius.begin(), radius.end());
+    double rmax = 0.0;  // of the radii a contact can have: a NaN radius touches nothing
+    for (double r : radius) rmax = r > rmax ? r : rmax;
+    if (rmax == 0.0) return out;  // no radius above zero: h = R_i + R_j - d > 0 holds for no pair
+    const double edge = 2.0 * rmax;
     struct Item {
         std::array<std::int64_t, 3> cell;
         std::int64_t id;
