@@ -14,7 +14,8 @@
 # Knobs: BUDGET_S, SETTLE_TIME (simulated seconds of settling, default 0.15: the 12-layer bed has
 # collapsed by then), SIZES (default "10000 100000 1000000"), BIG (default 10000000; 0 skips it),
 # CMP_N and CMP_STEPS (the comparisons' bed and length, default 2000 and 1000), CHECK_EVERY (steps
-# between the health checks of a settle, default 1500), RESULTS (default results/gpu). VARIANT=cuda_host runs the whole flow on the CPU, to try the script without a GPU.
+# between the health checks of a settle, default 1500), RESULTS (default results/gpu).
+# VARIANT=cuda_host runs the whole flow on the CPU, to try the script without a GPU.
 # Usage: scripts/device_check.sh [--pack [--fast-arch ARCH]] [--build-dir DIR]
 #   --pack            on the build machine: build DIR and pack DIR/dist for the GPU machine
 #   --fast-arch ARCH  with --pack: compile fast for the GPU machine's CPU (GCC's -march=ARCH, e.g.
