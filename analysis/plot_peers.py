@@ -5,7 +5,7 @@
       medians of the interleaved repetitions (suite variants from `demmat bench --json`, peers from the
       logs of their timed runs), µs per particle-step against N, each variant's ratio to LAMMPS in the
       same run, and where the time goes on the settled bed (each code's own phases).
-  plot_peers.py observables --dump FILE --scene TOML --code C --member M --stage S -o CSV
+  plot_peers.py observables --dump FILE --scene TOML --code C --member M --stage S [--step-scale F] -o CSV
       per frame of a LAMMPS-style dump: kinetic energy, bed height, normal force on the x_max wall,
       computed the same way for every code.
   plot_peers.py physics --work DIR --versions JSON --particles N --amplitude A --out DIR --figure PNG
@@ -239,7 +239,7 @@ def cmd_observables(a):
     for step, c in read_frames(a.dump):
         # Steps from the stage's start: demmat dump continues the state's step count, LAMMPS restarts at 0.
         first = step if first is None else first
-        step -= first
+        step = round((step - first) * a.step_scale)
         r = c["radius"]
         m = p["rho"] * (4.0 / 3.0) * math.pi * r ** 3
         inertia = 0.4 * m * r * r
@@ -264,11 +264,15 @@ def cmd_observables(a):
 # ---- physics -----------------------------------------------------------------------------------------------
 CODE_STYLE = {"suite": ("tab:blue", "suite (arrays, Gear)"),
               "suite_verlet": ("tab:green", "suite (arrays, velocity Verlet)"),
+              "suite_lammps_arms": ("tab:purple", "suite (arrays, Gear, LAMMPS's lever arms)"),
               "lammps": ("black", "LAMMPS (velocity Verlet)"),
+              "lammps_half_dt": ("tab:gray", "LAMMPS (velocity Verlet, Δt/2)"),
               "liggghts": ("tab:orange", "LIGGGHTS 3.8 (hertz/stiffness)")}
 # suite_verlet: the suite's law with LAMMPS's integrator family, so that the table can tell how much of
 # the suite's distance from LAMMPS is the integrator and how much the law's details (docs/peers.md).
-RELATIVE_TO_LAMMPS = ("suite", "suite_verlet")
+# With run_peers.sh --diagnose: suite_lammps_arms, the suite built with LAMMPS's lever arms (the law's
+# one remaining difference for the paper's law), and lammps_half_dt, LAMMPS's own time-step error.
+RELATIVE_TO_LAMMPS = ("suite", "suite_verlet", "suite_lammps_arms", "lammps_half_dt")
 
 
 def cmd_physics(a):
@@ -373,6 +377,8 @@ def main():
     o.add_argument("--code", required=True)
     o.add_argument("--member", type=int, required=True)
     o.add_argument("--stage", required=True)
+    o.add_argument("--step-scale", type=float, default=1.0,
+                   help="the run's time step over the scene's (a run at Δt/2: 0.5); its frames keep the others' times")
     o.add_argument("-o", required=True)
     p = sub.add_parser("physics")
     p.add_argument("--work", required=True)

@@ -9,7 +9,7 @@
 #     kinetic energy and bed height while settling, the wall force while compressing; results/peers/physics_*.
 # Usage: scripts/run_peers.sh [--full] [--n "1000 2000"] [--steps K] [--repetitions R] [--variants LIST]
 #                             [--members M] [--physics-n N] [--bench-only] [--physics-only] [--prepare-only]
-#                             [--contact "KEY=VALUE ..."] [--out DIR] [--build-dir DIR]
+#                             [--contact "KEY=VALUE ..."] [--diagnose] [--out DIR] [--build-dir DIR]
 #   default          N = 1000, 2000, 4000; 200 steps; 3 repetitions; every variant; 4 ensemble members
 #   --full           N = 1000 … 64000 (doubling), 500 steps, 5 repetitions, 8 ensemble members (the lead's run)
 #   --n LIST         the sizes N of the benchmark;  --physics-n N: the size of the physics cross-check (2000)
@@ -19,13 +19,16 @@
 #                    `demmat scene --contact`), e.g. "tangential=mindlin tangential_damping_ratio=0.5";
 #                    the bed settled with the law, every code with the law from the same particles
 #                    (LAMMPS's pair_style granular keywords, docs/peers.md); LIGGGHTS is left out
+#   --diagnose       two more rows in the physics cross-check, each removing one known difference from
+#                    LAMMPS: the suite built with LAMMPS's lever arms (DEMMAT_LEVER_ARMS=lammps, in
+#                    DIR-lammps-arms beside the build folder), and LAMMPS at half the time step
 #   --out DIR        results and figures in DIR instead of results/peers and results/figures (a second,
 #                    focused run beside the full one)
 #   --build-dir DIR  the build folder (default build, or $DEMMAT_BUILD_DIR); the peers' work files go
 #                    in DIR/peers
 source "$(dirname "$0")/lib.sh"
 ns="1000 2000 4000"; steps=200; reps=3; variants=all; members=4; phys_n=2000; warmup=20
-do_bench=1; do_phys=1; prepare_only=0; out=results/peers; figures=results/figures; contact=""
+do_bench=1; do_phys=1; prepare_only=0; diagnose=0; out=results/peers; figures=results/figures; contact=""
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --full) ns="1000 2000 4000 8000 16000 32000 64000"; steps=500; reps=5; members=8; shift ;;
@@ -40,6 +43,7 @@ while [[ $# -gt 0 ]]; do
     --prepare-only) prepare_only=1; shift ;;
     --out) need_value "$@"; out=$2; figures=$2; shift 2 ;;
     --contact) need_value "$@"; contact=$2; shift 2 ;;
+    --diagnose) diagnose=1; shift ;;
     *) shared_option "$@"; shift "$SHIFT" ;;
   esac
 done
@@ -50,6 +54,10 @@ positive_int --physics-n "$phys_n"
 install_deps --optional
 cmake_build -q "$BUILD_DIR" demmat
 demmat=$(demmat_in "$BUILD_DIR")
+if [[ $diagnose == 1 && $do_phys == 1 ]]; then
+  cmake_build -q "${BUILD_DIR%/}-lammps-arms" demmat -- -DDEMMAT_LEVER_ARMS=lammps
+  demmat_arms=$(demmat_in "${BUILD_DIR%/}-lammps-arms")
+fi
 lmp=$(command -v lmp || true)
 liggghts=$(command -v liggghts || true)
 # A contact law: its stages live in a folder of their own beside the paper's (law_<keys>), its scene
@@ -171,13 +179,23 @@ if [[ $do_phys == 1 ]]; then
       $demmat dump "$d/$stage.toml" --state "$base.state" --steps "$k" --every "$e" -o "$base.suite.dump" 2>/dev/null
       # The same law with velocity Verlet: how much of the suite's distance from LAMMPS is the integrator.
       $demmat dump "$d/$stage.toml" --state "$base.state" --integrator verlet --steps "$k" --every "$e" -o "$base.suite_verlet.dump" 2>/dev/null
+      if [[ $diagnose == 1 ]]; then
+        # The suite's Gear run with LAMMPS's lever arms, and LAMMPS at Δt/2 (its own time-step error):
+        # what each known difference contributes (docs/peers.md). The frames keep the times of the others.
+        $demmat_arms dump "$d/$stage.toml" --state "$base.state" --steps "$k" --every "$e" -o "$base.suite_lammps_arms.dump" 2>/dev/null
+        sed "s/^timestep .*/timestep $($PYTHON -c "import sys; print(repr(float(sys.argv[1]) / 2))" "$(awk '/^timestep /{print $2}' "$base.lammps")")/" \
+          "$base.lammps" > "$base.half_dt.lammps"
+        (cd "$p" && $lmp -var frag "$(basename "$base").half_dt.lammps" -var steps $((2 * k)) -var every $((2 * e)) \
+           -var dumpfile "$(basename "$base").lammps_half_dt.dump" -in "$OLDPWD/peers/lammps/in.trace" -log none -nocite > /dev/null 2>&1)
+      fi
       (cd "$p" && $lmp -var frag "$(basename "$base").lammps" -var steps "$k" -var every "$e" -var dumpfile "$(basename "$base").lammps.dump" \
          -in "$OLDPWD/peers/lammps/in.trace" -log none -nocite > /dev/null 2>&1)
       [[ -n "$liggghts" ]] && (cd "$p" && $liggghts -var frag "$(basename "$base").liggghts" -var steps "$k" -var every "$e" \
          -var dumpfile "$(basename "$base").liggghts.dump" -in "$OLDPWD/peers/liggghts/in.trace" -log none -nocite > /dev/null 2>&1)
-      for code in suite suite_verlet lammps liggghts; do
+      for code in suite suite_verlet suite_lammps_arms lammps lammps_half_dt liggghts; do
         [[ -f $base.$code.dump ]] || continue
-        $PYTHON analysis/plot_peers.py observables --dump "$base.$code.dump" --scene "$d/$stage.toml" \
+        half=(); [[ $code == lammps_half_dt ]] && half=(--step-scale 0.5)
+        $PYTHON analysis/plot_peers.py observables --dump "$base.$code.dump" --scene "$d/$stage.toml" "${half[@]}" \
           --code "$code" --member "$m" --stage "$stage" -o "$p/obs_${stage}_${code}_m$m.csv"
         rm -f "$base.$code.dump"   # frames are large; the observables are what is kept
       done

@@ -12,6 +12,18 @@
 
 namespace demmat {
 
+// The lever arms (physics.md §2): R − h/2 from each centre to the contact point, for the relative
+// velocity there and for the torque. LAMMPS's granular styles use the full radii in that velocity, and
+// fix wall/gran also puts a wall contact's torque at the full radius. A build configured with
+// -DDEMMAT_LEVER_ARMS=lammps takes LAMMPS's arms instead, to show by experiment how much of the
+// distance from LAMMPS they make (scripts/run_peers.sh --diagnose, docs/peers.md). It is not a law of
+// the suite: its runs are not the suite's results, and the f90 and pascal ports keep §2's arms.
+#ifdef DEMMAT_LAMMPS_LEVER_ARMS
+inline constexpr bool kLammpsLeverArms = true;
+#else
+inline constexpr bool kLammpsLeverArms = false;
+#endif
+
 // Per-run constants of the contact law, derived once from the materials (see material.hpp).
 template <class T>
 struct ContactParams {
@@ -155,7 +167,10 @@ DEMMAT_HD inline void pair_law(const Vec3<T>& dx, T d, T h, const Vec3<T>& vi, c
     const Vec3<T> di = (ri - h * S(0.5)) * n;
     const Vec3<T> dj = -((rj - h * S(0.5)) * n);
     Vec3<T> u = vi - vj;
-    if constexpr (M::rotation) u = u + cross(wi, di) - cross(wj, dj);
+    if constexpr (M::rotation) {
+        if constexpr (kLammpsLeverArms) u = u + cross(wi, ri * n) - cross(wj, -(rj * n));
+        else u = u + cross(wi, di) - cross(wj, dj);
+    }
     Vec3<T> ft;
     if constexpr (M::polydisperse) contact_force<M>(n, h, u, pair_coefficients(ri, rj, mi, mj, p), p, out.f_i, ft);
     else contact_force<M>(n, h, u, mono, p, out.f_i, ft);
@@ -217,13 +232,21 @@ inline auto particle_contact_lanes(const Vec3<V>& xi, const Vec3<V>& xj, const V
 }
 
 namespace detail {
+// A wall contact's lever arm, for its velocity and its torque alike (see kLammpsLeverArms).
+template <class S, class T>
+DEMMAT_HD inline T wall_lever_arm(T ri, T h)
+{
+    if constexpr (kLammpsLeverArms) return ri;
+    else return ri - h * S(0.5);
+}
+
 // The particle–wall law once the overlap h > 0 is known (in every lane whose result is kept).
 template <class M, class T, class S>
 DEMMAT_HD inline void wall_law(T h, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T mi, const Vec3<T>& normal, const Vec3<T>& vw,
                      const ContactParams<S>& p, const Coefficients<T>& mono, ContactForce<T>& out)
 {
     const Vec3<T> n = -normal;
-    const Vec3<T> di = (ri - h * S(0.5)) * n;
+    const Vec3<T> di = wall_lever_arm<S>(ri, h) * n;
     Vec3<T> u = vi;
     if constexpr (M::moving_walls) u = vi - vw;
     if constexpr (M::rotation) u = u + cross(wi, di);

@@ -190,7 +190,8 @@ inline void pair_memory_law(const Vec3<T>& dx, T d, T h, const Vec3<T>& vi, cons
     const Vec3<T> di = (ri - h * S(0.5)) * n;
     const Vec3<T> dj = -((rj - h * S(0.5)) * n);
     Vec3<T> u = vi - vj;
-    u = u + cross(wi, di) - cross(wj, dj);
+    if constexpr (kLammpsLeverArms) u = u + cross(wi, ri * n) - cross(wj, -(rj * n));
+    else u = u + cross(wi, di) - cross(wj, dj);
     Vec3<T> ft, troll;
     memory_law<M>(n, h, u, wi - wj, ri * rj / (ri + rj), mi * mj / (mi + mj), p.hertz_pp, q.shear8_pp, p, q, s, advance, out.f_i, ft,
                   troll);
@@ -210,7 +211,7 @@ inline void wall_memory_law(T h, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T m
 {
     static_assert(M::rotation && M::friction && M::moving_walls, "a §9 law runs on the full model (with_law_model)");
     const Vec3<T> n = -normal;
-    const Vec3<T> di = (ri - h * S(0.5)) * n;
+    const Vec3<T> di = wall_lever_arm<S>(ri, h) * n;
     Vec3<T> u = vi - vw;
     u = u + cross(wi, di);
     Vec3<T> ft, troll;
