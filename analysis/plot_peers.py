@@ -321,7 +321,10 @@ def write_physics(df, versions, particles, amplitude, out, figure):
              + "Produced by scripts/run_peers.sh. "
              f"Where the perturbations have not yet grown (the short compression window), the ensemble band is "
              f"narrower than the codes' systematic differences and z is large for differences of 0.1 %: read the "
-             f"relative difference there (docs/peers.md explains the causes).", ""]
+             f"relative difference there (docs/peers.md explains the causes)."
+             + (" Diagnostic rows (run_peers.sh --diagnose): the suite built with LAMMPS's lever arms, and LAMMPS "
+                "at half the time step, whose distance from LAMMPS is LAMMPS's own time-step error."
+                if {"suite_lammps_arms", "lammps_half_dt"} & set(df.code.unique()) else ""), ""]
     for stage, q, title, _ in panels:
         s = df[df.stage == stage]
         times = sorted(s.time.unique())
