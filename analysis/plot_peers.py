@@ -270,8 +270,8 @@ CODE_STYLE = {"suite": ("tab:blue", "suite (arrays, Gear)"),
               "liggghts": ("tab:orange", "LIGGGHTS 3.8 (hertz/stiffness)")}
 # suite_verlet: the suite's law with LAMMPS's integrator family, so that the table can tell how much of
 # the suite's distance from LAMMPS is the integrator and how much the law's details (docs/peers.md).
-# With run_peers.sh --diagnose: suite_lammps_arms, the suite built with LAMMPS's lever arms (the law's
-# one remaining difference for the paper's law), and lammps_half_dt, LAMMPS's own time-step error.
+# With run_peers.sh --diagnose: suite_lammps_arms, the suite built with LAMMPS's lever arms, and
+# lammps_half_dt, LAMMPS at Δt/2, whose distance from LAMMPS is LAMMPS's own time-step error.
 RELATIVE_TO_LAMMPS = ("suite", "suite_verlet", "suite_lammps_arms", "lammps_half_dt")
 
 
