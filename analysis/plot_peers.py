@@ -265,14 +265,18 @@ def cmd_observables(a):
 CODE_STYLE = {"suite": ("tab:blue", "suite (arrays, Gear)"),
               "suite_verlet": ("tab:green", "suite (arrays, velocity Verlet)"),
               "suite_lammps_arms": ("tab:purple", "suite (arrays, Gear, LAMMPS's lever arms)"),
+              "suite_as_lammps": ("tab:red", "suite (arrays, velocity Verlet, LAMMPS's lever arms and half-step velocity)"),
               "lammps": ("black", "LAMMPS (velocity Verlet)"),
               "lammps_half_dt": ("tab:gray", "LAMMPS (velocity Verlet, Δt/2)"),
               "liggghts": ("tab:orange", "LIGGGHTS 3.8 (hertz/stiffness)")}
 # suite_verlet: the suite's law with LAMMPS's integrator family, so that the table can tell how much of
 # the suite's distance from LAMMPS is the integrator and how much the law's details (docs/peers.md).
-# With run_peers.sh --diagnose: suite_lammps_arms, the suite built with LAMMPS's lever arms, and
-# lammps_half_dt, LAMMPS at Δt/2, whose distance from LAMMPS is LAMMPS's own time-step error.
-RELATIVE_TO_LAMMPS = ("suite", "suite_verlet", "suite_lammps_arms", "lammps_half_dt")
+# With run_peers.sh --diagnose: suite_lammps_arms, the suite built with LAMMPS's lever arms;
+# suite_as_lammps, that build's velocity Verlet at LAMMPS's half-step velocity (every difference of
+# physics.md §9's list removed); lammps_half_dt, LAMMPS at Δt/2, whose distance from LAMMPS is LAMMPS's
+# own time-step error.
+DIAGNOSTIC = ("suite_lammps_arms", "suite_as_lammps", "lammps_half_dt")
+RELATIVE_TO_LAMMPS = ("suite", "suite_verlet") + DIAGNOSTIC
 
 
 def cmd_physics(a):
@@ -322,9 +326,10 @@ def write_physics(df, versions, particles, amplitude, out, figure):
              f"Where the perturbations have not yet grown (the short compression window), the ensemble band is "
              f"narrower than the codes' systematic differences and z is large for differences of 0.1 %: read the "
              f"relative difference there (docs/peers.md explains the causes)."
-             + (" Diagnostic rows (run_peers.sh --diagnose): the suite built with LAMMPS's lever arms, and LAMMPS "
-                "at half the time step, whose distance from LAMMPS is LAMMPS's own time-step error."
-                if {"suite_lammps_arms", "lammps_half_dt"} & set(df.code.unique()) else ""), ""]
+             + (" Diagnostic rows (run_peers.sh --diagnose): the suite built with LAMMPS's lever arms (Gear), the "
+                "same build's velocity Verlet at LAMMPS's half-step velocity (every difference listed in docs/physics.md "
+                "removed), and LAMMPS at half the time step, whose distance from LAMMPS is LAMMPS's own time-step error."
+                if set(DIAGNOSTIC) & set(df.code.unique()) else ""), ""]
     for stage, q, title, _ in panels:
         s = df[df.stage == stage]
         times = sorted(s.time.unique())

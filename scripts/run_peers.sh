@@ -19,9 +19,11 @@
 #                    `demmat scene --contact`), e.g. "tangential=mindlin tangential_damping_ratio=0.5";
 #                    the bed settled with the law, every code with the law from the same particles
 #                    (LAMMPS's pair_style granular keywords, docs/peers.md); LIGGGHTS is left out
-#   --diagnose       two more rows in the physics cross-check, each removing one known difference from
-#                    LAMMPS: the suite built with LAMMPS's lever arms (DEMMAT_LEVER_ARMS=lammps, in
-#                    DIR-lammps-arms beside the build folder), and LAMMPS at half the time step
+#   --diagnose       three more rows in the physics cross-check, removing the known differences from
+#                    LAMMPS (physics.md §9): the suite built with LAMMPS's lever arms and half-step
+#                    velocity (DEMMAT_LEVER_ARMS=lammps, DEMMAT_VERLET_VELOCITY=half_step, in DIR-as-lammps
+#                    beside the build folder) run with Gear (the arms alone) and with velocity Verlet (every
+#                    listed difference removed), and LAMMPS at half the time step (its own time-step error)
 #   --out DIR        results and figures in DIR instead of results/peers and results/figures (a second,
 #                    focused run beside the full one)
 #   --build-dir DIR  the build folder (default build, or $DEMMAT_BUILD_DIR); the peers' work files go
@@ -55,8 +57,8 @@ install_deps --optional
 cmake_build -q "$BUILD_DIR" demmat
 demmat=$(demmat_in "$BUILD_DIR")
 if [[ $diagnose == 1 && $do_phys == 1 ]]; then
-  cmake_build -q "${BUILD_DIR%/}-lammps-arms" demmat -- -DDEMMAT_LEVER_ARMS=lammps
-  demmat_arms=$(demmat_in "${BUILD_DIR%/}-lammps-arms")
+  cmake_build -q "${BUILD_DIR%/}-as-lammps" demmat -- -DDEMMAT_LEVER_ARMS=lammps -DDEMMAT_VERLET_VELOCITY=half_step
+  demmat_as_lammps=$(demmat_in "${BUILD_DIR%/}-as-lammps")
 fi
 lmp=$(command -v lmp || true)
 liggghts=$(command -v liggghts || true)
@@ -180,9 +182,11 @@ if [[ $do_phys == 1 ]]; then
       # The same law with velocity Verlet: how much of the suite's distance from LAMMPS is the integrator.
       $demmat dump "$d/$stage.toml" --state "$base.state" --integrator verlet --steps "$k" --every "$e" -o "$base.suite_verlet.dump" 2>/dev/null
       if [[ $diagnose == 1 ]]; then
-        # The suite's Gear run with LAMMPS's lever arms, and LAMMPS at Δt/2 (its own time-step error):
-        # what each known difference contributes (docs/peers.md). The frames keep the times of the others.
-        $demmat_arms dump "$d/$stage.toml" --state "$base.state" --steps "$k" --every "$e" -o "$base.suite_lammps_arms.dump" 2>/dev/null
+        # The suite with LAMMPS's lever arms (Gear), with every listed difference removed (velocity Verlet
+        # at the half-step velocity too), and LAMMPS at Δt/2 (its own time-step error): what each known
+        # difference contributes (docs/peers.md). The half-step run's frames keep the times of the others.
+        $demmat_as_lammps dump "$d/$stage.toml" --state "$base.state" --steps "$k" --every "$e" -o "$base.suite_lammps_arms.dump" 2>/dev/null
+        $demmat_as_lammps dump "$d/$stage.toml" --state "$base.state" --integrator verlet --steps "$k" --every "$e" -o "$base.suite_as_lammps.dump" 2>/dev/null
         sed "s/^timestep .*/timestep $($PYTHON -c "import sys; print(repr(float(sys.argv[1]) / 2))" "$(awk '/^timestep /{print $2}' "$base.lammps")")/" \
           "$base.lammps" > "$base.half_dt.lammps"
         (cd "$p" && $lmp -var frag "$(basename "$base").half_dt.lammps" -var steps $((2 * k)) -var every $((2 * e)) \
@@ -192,7 +196,7 @@ if [[ $do_phys == 1 ]]; then
          -in "$OLDPWD/peers/lammps/in.trace" -log none -nocite > /dev/null 2>&1)
       [[ -n "$liggghts" ]] && (cd "$p" && $liggghts -var frag "$(basename "$base").liggghts" -var steps "$k" -var every "$e" \
          -var dumpfile "$(basename "$base").liggghts.dump" -in "$OLDPWD/peers/liggghts/in.trace" -log none -nocite > /dev/null 2>&1)
-      for code in suite suite_verlet suite_lammps_arms lammps lammps_half_dt liggghts; do
+      for code in suite suite_verlet suite_lammps_arms suite_as_lammps lammps lammps_half_dt liggghts; do
         [[ -f $base.$code.dump ]] || continue
         half=(); [[ $code == lammps_half_dt ]] && half=(--step-scale 0.5)
         $PYTHON analysis/plot_peers.py observables --dump "$base.$code.dump" --scene "$d/$stage.toml" "${half[@]}" \

@@ -137,7 +137,14 @@ struct VerletCoefficients {
 // Choice (docs/accuracy.md): velocity-dependent forces (damping, friction) are evaluated at the
 // Euler-predicted v(t+Δt), whose error is O(Δt²), so the scheme stays second order with damping; the
 // common alternative, the half-step velocity v(t+Δt/2) (LAMMPS, LIGGGHTS), is only first order in the
-// damping term.
+// damping term. A build configured with -DDEMMAT_VERLET_VELOCITY=half_step takes LAMMPS's instead, to
+// show by experiment how much of the distance from LAMMPS it makes (scripts/run_peers.sh --diagnose,
+// docs/peers.md); like the lever arms of contact_law.hpp it is not a scheme of the suite.
+#ifdef DEMMAT_VERLET_HALF_STEP_VELOCITY
+inline constexpr bool kVerletHalfStepVelocity = true;
+#else
+inline constexpr bool kVerletHalfStepVelocity = false;
+#endif
 struct VerletScheme {
     static constexpr Integrator id = Integrator::verlet;
     template <class T>
@@ -147,12 +154,18 @@ struct VerletScheme {
     static void predict(V& x, V& v, V& a, V&, V&, const V&, const VerletCoefficients<T>& k)
     {
         x = x + k.dt * v + k.half_dt2 * a;
-        v = v + k.dt * a;
+        if constexpr (kVerletHalfStepVelocity)
+            v = v + k.half_dt * a;  // v(t+Δt/2): LAMMPS's fix nve/sphere
+        else
+            v = v + k.dt * a;
     }
     template <class V, class D, class T>
     static void correct(V&, V& v, V& a, V&, V&, V&, const D& a_new, const VerletCoefficients<T>& k)
     {
-        v = v + k.half_dt * (a_new - a);
+        if constexpr (kVerletHalfStepVelocity)
+            v = v + k.half_dt * a_new;
+        else
+            v = v + k.half_dt * (a_new - a);
         a = a_new;
     }
 };
