@@ -23,7 +23,8 @@
 #                    LAMMPS (physics.md §9): the suite built with LAMMPS's lever arms and half-step
 #                    velocity (DEMMAT_LEVER_ARMS=lammps, DEMMAT_VERLET_VELOCITY=half_step, in DIR-as-lammps
 #                    beside the build folder) run with Gear (the arms alone) and with velocity Verlet (every
-#                    listed difference removed), and LAMMPS at half the time step (its own time-step error)
+#                    listed difference removed), and LAMMPS at half the time step (its own time-step error);
+#                    and single contacts of the same law, each code against LAMMPS (single_contacts.md)
 #   --out DIR        results and figures in DIR instead of results/peers and results/figures (a second,
 #                    focused run beside the full one)
 #   --build-dir DIR  the build folder (default build, or $DEMMAT_BUILD_DIR); the peers' work files go
@@ -206,6 +207,22 @@ if [[ $do_phys == 1 ]]; then
     done
     echo "== member $m/$members done"
   done
+  if [[ $diagnose == 1 ]]; then
+    # Single contacts, where the codes can be compared contact by contact (in the bed the trajectories
+    # separate): the stage's law on four isolated grains, every build and LAMMPS (analysis/peer_contacts.py).
+    c=$p/contacts; rm -rf "$c"; mkdir -p "$c"
+    $PYTHON analysis/peer_contacts.py scene --stage "$d/compression.toml" -o "$c/contacts.toml"
+    $demmat export-lammps "$c/contacts.toml" -o "$c/contacts.data" 2>/dev/null
+    $demmat import-lammps "$c/contacts.data" --scene "$c/contacts.toml" -o "$c/contacts.state"
+    run_contacts() { "$@" "$c/contacts.toml" --state "$c/contacts.state" --steps 3000 --every 500 2>/dev/null; }
+    run_contacts $demmat dump -o "$c/suite.dump"
+    run_contacts $demmat dump --integrator verlet -o "$c/suite_verlet.dump"
+    run_contacts $demmat_as_lammps dump --integrator verlet -o "$c/suite_as_lammps.dump"
+    (cd "$c" && $lmp -var frag contacts.lammps -var steps 3000 -var every 500 -var dumpfile lammps.dump \
+       -in "$OLDPWD/peers/lammps/in.trace" -log none -nocite > /dev/null 2>&1)
+    $PYTHON analysis/peer_contacts.py compare --work "$c" --versions "$work/versions.json" \
+      --build "suite=$demmat" --build "suite built as LAMMPS=$demmat_as_lammps" --out "$out"
+  fi
   $PYTHON analysis/plot_peers.py physics --work "$p" --versions "$work/versions.json" --particles "$n" \
     --amplitude "$amplitude" --out "$out" --figure "$figures/peers_physics_${n}.png"
 fi
