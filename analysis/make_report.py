@@ -170,7 +170,7 @@ def build(root, out, paper):
     section(rep, "Beside LAMMPS and LIGGGHTS: time per step", ["peers/bench_peers.md"],
             [("figures/peers_us_per_particle_step.png", "µs per particle-step against N")],
             "the benchmark beside LAMMPS and LIGGGHTS", "scripts/run_peers.sh")
-    section(rep, "Validation: the physics beside LAMMPS and LIGGGHTS", [physics],
+    section(rep, "Validation: the physics beside LAMMPS and LIGGGHTS", [physics, "peers/single_contacts.md"],
             [(n and f"figures/peers_physics_{n}.png", "Physics cross-check")],
             "the ensemble cross-check of the physics against LAMMPS and LIGGGHTS", "scripts/run_peers.sh")
     for folder, law, keys in (("peers_mindlin", "tangential mindlin", "tangential=mindlin ..."),
@@ -179,7 +179,7 @@ def build(root, out, paper):
                 [(f"{folder}/peers_us_per_particle_step.png", f"µs per particle-step against N, {law}")],
                 "the benchmark beside LAMMPS with a law of physics.md §9", f"scripts/run_peers.sh --contact \"{keys}\" --out results/{folder}")
         physics_law = newest(root, f"{folder}/physics_*.md")
-        section(rep, f"The physics beside LAMMPS with contact memory ({law})", [physics_law],
+        section(rep, f"The physics beside LAMMPS with contact memory ({law})", [physics_law, f"{folder}/single_contacts.md"],
                 [(physics_law and physics_law.replace("physics_", "peers_physics_").replace(".md", ".png"), f"Physics cross-check, {law}")],
                 "the ensemble cross-check with a law of physics.md §9", f"scripts/run_peers.sh --contact \"{keys}\" --out results/{folder}")
     section(rep, "What contact memory costs each style", ["memory_cost/table.md"], [("memory_cost/memory_cost.png", "memory cost")],

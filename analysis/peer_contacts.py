@@ -45,7 +45,8 @@ def fmt(v):
 
 
 def cmd_scene(a):
-    text = open(a.stage).read()
+    with open(a.stage) as f:
+        text = f.read()
     s = tomllib.loads(text)
     lo, hi = s["domain"]["min"], s["domain"]["max"]
     text = re.split(r"(?m)^\[particles\]", text)[0]
@@ -84,7 +85,8 @@ def largest_difference(frames_a, frames_b, radius, cols):
 
 
 def cmd_compare(a):
-    versions = json.load(open(a.versions))
+    with open(a.versions) as f:
+        versions = json.load(f)
     ref = list(read_frames(os.path.join(a.work, "lammps.dump")))
     radius = ref[0][1]["radius"]
     rows = []
@@ -107,7 +109,8 @@ def cmd_compare(a):
         out = subprocess.run([exe, "--version"], capture_output=True, text=True, check=True).stdout.split("\n")
         info = dict(line.split(" ", 1) for line in out[1:] if " " in line)
         builds.append(f"{name}: commit {info.get('commit', '?')[:10]}, {info.get('compiler', '?')}, `{info.get('flags', '?')}`")
-    cpu = next((l.split(":", 1)[1].strip() for l in open("/proc/cpuinfo") if l.startswith("model name")), platform.machine())
+    with open("/proc/cpuinfo") as f:
+        cpu = next((l.split(":", 1)[1].strip() for l in f if l.startswith("model name")), platform.machine())
     lines = ["# Single contacts: the suite against LAMMPS, contact by contact", "",
              f"Four grains, no gravity, the contact law of the physics cross-check ({versions.get('contact_law', 'the paper')}), "
              f"{STEPS} steps; each grain makes one contact in isolation. Largest difference from LAMMPS over "

@@ -282,6 +282,77 @@ class PeersBench(unittest.TestCase):
         self.assertEqual(ratio, f"{(2e-5 + 3e-6 + 5e-5) / 1.01e-4:.2f}")  # totals only in the ratio table
 
 
+class PeerContacts(unittest.TestCase):
+    """peer_contacts.py: the four-grain scene keeps the stage's law and walls and sets each contact up as
+    meant; the comparison reports the largest difference per grain, in v and in R·ω."""
+
+    def setUp(self):
+        import peer_contacts
+        self.pc = peer_contacts
+        self.work = tempfile.mkdtemp()
+        self.addCleanup(shutil.rmtree, self.work)
+
+    def test_scene_sets_up_one_contact_per_grain_and_keeps_the_law(self):
+        import tomllib
+        # The committed compression scene, with a law of memory; its particles come from a state file.
+        with open(os.path.join(HERE, os.pardir, "scenes", "dense_bed_2000_compression.toml")) as f:
+            text = f.read().replace("[particles]", '[contact]\ntangential = "mindlin"\n\n[particles]', 1)
+        with open(os.path.join(self.work, "stage.toml"), "w") as f:
+            f.write(text)
+        out = os.path.join(self.work, "c.toml")
+        self.pc.cmd_scene(type("A", (), {"stage": os.path.join(self.work, "stage.toml"), "o": out}))
+        with open(out, "rb") as f:
+            s = tomllib.load(f)
+        self.assertEqual(s["time"]["gravity"], [0, 0, 0])
+        self.assertEqual(s["contact"]["tangential"], "mindlin")
+        self.assertEqual(len(s["wall"]), 6)
+        g = s["particles"]["particle"]
+        self.assertEqual(len(g), 4)
+        lo, hi = s["domain"]["min"], s["domain"]["max"]
+        pos = [p["position"] for p in g]
+        rad = [p["radius"] for p in g]
+        for x, r in zip(pos, rad):
+            for c in range(3):
+                self.assertTrue(lo[c] + r <= x[c] <= hi[c] - r, f"a grain outside the domain: {x}")
+        d = [b - a for a, b in zip(pos[0], pos[1])]
+        gap = sum(c * c for c in d) ** 0.5 - rad[0] - rad[1]
+        closing = -sum((vb - va) * c for va, vb, c in zip(g[0]["velocity"], g[1]["velocity"], d))
+        self.assertGreater(gap, 0.0)
+        self.assertGreater(closing, 0.0, "the pair must approach")
+        self.assertAlmostEqual(hi[0] - pos[2][0] - rad[2], 0.0075)
+        self.assertAlmostEqual(pos[3][2] - lo[2] - rad[3], 0.001)
+        self.assertLess(g[3]["velocity"][2], 0.0, "the grain must fall onto z_min")
+
+    def dump(self, name, frames):
+        with open(os.path.join(self.work, name), "w") as f:
+            for step, rows in frames:
+                f.write(f"ITEM: TIMESTEP\n{step}\nITEM: NUMBER OF ATOMS\n{len(rows)}\nITEM: BOX BOUNDS ff ff ff\n0 1\n0 1\n0 1\n"
+                        "ITEM: ATOMS id radius x y z vx vy vz omegax omegay omegaz\n")
+                for r in rows:
+                    f.write(" ".join(repr(float(v)) for v in r) + "\n")
+
+    def test_compare_reports_the_largest_difference_per_grain(self):
+        base = [[i + 1, 0.004, 0, 0, 0, 0.1, 0, 0, 0, 0, 1.0] for i in range(4)]
+        moved = [list(r) for r in base]
+        moved[2][6] += 3e-4       # grain 3: Δv_y
+        moved[1][9] += 2.0        # grain 2: Δω_y, R·Δω = 8e-3
+        self.dump("lammps.dump", [(0, base), (500, base)])
+        self.dump("suite.dump", [(0, base), (500, moved)])
+        self.dump("suite_as_lammps.dump", [(0, base), (500, base)])
+        with open(os.path.join(self.work, "versions.json"), "w") as f:
+            f.write('{"lammps": "test"}')
+        out = os.path.join(self.work, "out")
+        self.pc.cmd_compare(type("A", (), {"work": self.work, "versions": os.path.join(self.work, "versions.json"),
+                                           "build": [], "out": out}))
+        import pandas as pd
+        df = pd.read_csv(os.path.join(out, "single_contacts.csv")).set_index(["code", "grain"])
+        self.assertAlmostEqual(df.loc[("suite", 3), "max_dv"], 3e-4, delta=1e-9)
+        self.assertAlmostEqual(df.loc[("suite", 2), "max_r_domega"], 8e-3, delta=1e-9)
+        self.assertEqual(df.loc[("suite", 1), "max_dv"], 0.0)
+        self.assertEqual(float(df.xs("suite_as_lammps").max().max_dv), 0.0)
+        self.assertIn("suite_as_lammps", set(df.index.get_level_values(0)))
+
+
 class OneN(unittest.TestCase):
     def test_no_curve_against_n_from_one_n(self):
         """The sample has one N: scaling and where-the-time-goes are tables, and a stale figure goes."""
