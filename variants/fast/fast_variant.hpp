@@ -20,6 +20,7 @@
 // Instantiated for the models fast.cpp's dispatch names (fast_models.hpp), each in the file of its kind.
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <utility>
@@ -102,26 +103,27 @@ public:
         // |Δx_i| + |Δx_j| ≤ 2·max|Δx|. 0.9 leaves room for rounding; a NaN fails the test and goes to
         // the rebuild, whose cell search reports it. (Walls need no list: see wall_contacts.hpp.)
         const double half = 0.9 * skin_ * 0.5;
-        int over = !(half > 0.0);
+        std::atomic<int> over{!(half > 0.0)};
         std::size_t listing_team = 1;
         const std::size_t n = p_.n;
-#pragma omp parallel reduction(| : over) if (par_)
-        {
+        in_team(par_, [&] {
             const auto [lo, hi] = thread_range(n);
             const std::size_t t = std::size_t(thread_index());
             if (t == 0) listing_team = std::size_t(thread_count());
             walls_.clear_list(t);
+            int mine = 0;
             for (std::size_t b0 = lo; b0 < hi; b0 += kPassBlock) {
                 const std::size_t b1 = std::min(hi, b0 + kPassBlock);
                 p_.template integrate<M::rotation>(b0, b1, fused);
-                over |= p_.moved_too_far(b0, b1, half * half);
+                mine |= p_.moved_too_far(b0, b1, half * half);
                 p_.refresh_records(b0, b1);
                 if constexpr (M::walls) walls_.list(p_, b0, b1, t);
             }
             walls_.size_results(t);
-        }
+            if (mine) over.store(1, std::memory_order_relaxed);
+        });
         walls_.listed_by(listing_team, n);
-        rebuild_due_ = over != 0;
+        rebuild_due_ = over.load(std::memory_order_relaxed) != 0;
     }
 
     void search() override
@@ -237,8 +239,7 @@ private:
         p_.xref = p_.x;
         walls_.begin_listing();
         std::size_t listing_team = 1;
-#pragma omp parallel if (par_)
-        {
+        in_team(par_, [&] {
             const auto [lo, hi] = thread_range(n);
             const std::size_t t = std::size_t(thread_index());
             if (t == 0) listing_team = std::size_t(thread_count());
@@ -246,7 +247,7 @@ private:
             walls_.clear_list(t);
             if constexpr (M::walls) walls_.list(p_, lo, hi, t, [this](std::size_t s) { return std::size_t(cells_.key(s).from); });
             walls_.size_results(t);
-        }
+        });
         walls_.listed_by(listing_team, n);
     }
 

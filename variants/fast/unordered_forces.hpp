@@ -5,6 +5,7 @@
 // over the threads, in thread order, and adds its walls. Deterministic for a fixed thread count, but
 // its bits depend on the storage order and the thread count.
 #include <algorithm>
+#include <atomic>
 #include <cstdint>
 #include <utility>
 #include <vector>
@@ -31,11 +32,10 @@ public:
         const std::size_t n = p.n;
         const std::size_t limit = std::size_t(thread_limit());
         if (loads_.size() < limit) loads_.resize(limit);
-        std::int64_t pp = 0, pw = 0;
+        std::atomic<std::int64_t> pp{0}, pw{0};
         std::size_t team = 1;
         const PairKernel<M> kernel(list, p, law, nullptr, prefetch);
-#pragma omp parallel reduction(+ : pp, pw) if (parallel)
-        {
+        in_team(parallel, [&] {
             const std::size_t nt = std::size_t(thread_count()), t = std::size_t(thread_index());
             if (t == 0) team = nt;
             const auto [lo, hi] = thread_range(n);
@@ -60,8 +60,8 @@ public:
                 walls.add(s, f, tq);
                 p.store_sum(s, f, tq);
             }
-        }
-        return {pp, pw, team};
+        });
+        return {pp.load(), pw.load(), team};
     }
 
     std::size_t bytes() const { return heap_bytes(loads_); }

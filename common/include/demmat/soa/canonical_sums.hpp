@@ -103,15 +103,14 @@ public:
             throw CapacityError(fmt::format("the fast variant's canonical sweep needs a ring of {} slots, more than its 32-bit offsets "
                                             "reach (a particle's partners are {} slots apart in storage)", ring_slots, reach));
         first_planned_ = false;
-#pragma omp parallel if (parallel)
-        {
+        in_team(parallel, [&] {
 #pragma omp single nowait
             schedule(list, last_chunk, by_last, last_bucket_);
             if (thread_count() > 1) {
 #pragma omp single nowait
                 plan_first(list);
             }
-        }
+        });
     }
 
     // The downward threads' schedule, once per list (a sweep of two threads or more asks for it).

@@ -8,6 +8,7 @@
 // particles whose last slot (as i or as j) was in it, the downward one those whose first was. The others
 // straddle the meeting point or the end of a piece; they are summed after the sweep. Which thread sums a
 // particle, and when, changes no bit of its sum.
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <vector>
@@ -35,7 +36,7 @@ public:
     {
         constexpr std::size_t kChunk = CanonicalSums::kChunk;
         const std::size_t n = p.n;
-        std::int64_t pp = 0, pw = 0;
+        std::atomic<std::int64_t> pp{0}, pw{0};
         std::size_t team = 1;
         const Index* pstart = list.start.data();
         const Index* by_last = sums.by_last.order.data();
@@ -50,8 +51,7 @@ public:
         }
         if (rings_.size() < limit) rings_.resize(limit);
         const PairKernel<M> kernel(list, p, law, stretches, prefetch);
-#pragma omp parallel reduction(+ : pp, pw) if (parallel)
-        {
+        in_team(parallel, [&] {
             const std::size_t nt = std::size_t(thread_count()), t = std::size_t(thread_index());
             if (t == 0) team = nt;
             // Two threads to a piece, one from each end; an odd thread count leaves the last piece one.
@@ -70,7 +70,8 @@ public:
             if (ring.size() < ring_slots + 2) ring.assign(ring_slots + 2, Slot{});
             ring[ring_slots] = ring[ring_slots + 1] = Slot{};  // a larger ring from before may hold slots there
             // The kernel's records and every list of wall candidates are ready (predict(), or a rebuild).
-            if constexpr (M::walls) pw += walls.compute<M>(p, law);
+            std::int64_t my_pp = 0, my_pw = 0;  // this thread's contacts, added to pp and pw once
+            if constexpr (M::walls) my_pw = walls.compute<M>(p, law);
 #pragma omp barrier
             const std::size_t c0 = piece_chunk_[pc], c1 = piece_chunk_[pc + 1];
             const SlotSink in_ring{ring.data(), ring_slots - 1, nullptr};
@@ -78,7 +79,7 @@ public:
                 // Slots near the end of a piece are also kept in all_, for the sums that straddle two pieces.
                 const bool edge = (pc > 0 && ch < c0 + span) || (pc + 1 < pieces && ch + span >= c1);
                 const SlotSink sink{in_ring.ring, in_ring.mask, edge ? all_.data() : nullptr};
-                pp += kernel.template run<true>(std::size_t(pstart[ch * kChunk]), std::size_t(pstart[std::min(n, (ch + 1) * kChunk)]), nullptr, sink);
+                my_pp += kernel.template run<true>(std::size_t(pstart[ch * kChunk]), std::size_t(pstart[std::min(n, (ch + 1) * kChunk)]), nullptr, sink);
                 // The groups of this chunk's schedule; a group with a particle that straddles the end of
                 // the piece (three threads or more) goes a particle at a time, without that one.
                 const SlotSource from{in_ring.ring, in_ring.ring, in_ring.mask, 0};
@@ -139,8 +140,10 @@ public:
                         if (f >= b0 && f < c0) sums.sum_particle(s, everything, list, walls, p);
                     }
             }
-        }
-        return {pp, pw, team};
+            pp += my_pp;
+            pw += my_pw;
+        });
+        return {pp.load(), pw.load(), team};
     }
 
     std::size_t bytes() const { return heap_bytes(piece_chunk_, rings_, all_) + nclaims_ * sizeof(Claim); }

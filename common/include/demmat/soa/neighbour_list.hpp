@@ -55,8 +55,7 @@ public:
         start.assign(n + 1, 0);
         Index* pstart = start.data();
         if (scan_.size() < std::size_t(thread_limit())) scan_.resize(std::size_t(thread_limit()));
-#pragma omp parallel if (parallel)
-        {
+        in_team(parallel, [&] {
             const auto [lo, hi] = thread_range(n);
             std::vector<Index>& mine = scan_[std::size_t(thread_index())];
             mine.clear();
@@ -90,15 +89,17 @@ public:
                 if (canonical)
                     std::sort(ppartner + pstart[s], ppartner + pstart[s + 1], [&id](Index x, Index y) { return id[x] < id[y]; });
             }
-        }
+        });
         if (!canonical) return;
         bucket_sort(partner, n, jstart, as_j);
         const Index* pjstart = jstart.data();
         const Index* powner = owner.data();
         Index* pas_j = as_j.data();
-#pragma omp parallel for schedule(static) if (parallel)
-        for (std::size_t s = 0; s < n; ++s)
-            std::sort(pas_j + pjstart[s], pas_j + pjstart[s + 1], [&](Index x, Index y) { return id[powner[x]] < id[powner[y]]; });
+        in_team(parallel, [&] {
+#pragma omp for schedule(static)
+            for (std::size_t s = 0; s < n; ++s)
+                std::sort(pas_j + pjstart[s], pas_j + pjstart[s + 1], [&](Index x, Index y) { return id[powner[x]] < id[powner[y]]; });
+        });
     }
 
     std::size_t bytes() const { return heap_bytes(start, partner, owner, jstart, as_j, spans, scan_); }

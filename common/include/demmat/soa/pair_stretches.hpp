@@ -17,6 +17,7 @@
 #include "neighbour_list.hpp"
 #include "particles.hpp"
 #include "quads.hpp"
+#include "team.hpp"
 
 namespace demmat::fast {
 
@@ -143,18 +144,20 @@ public:
     void apply(const NeighbourList& list, const std::vector<Index>& id, std::size_t n, bool parallel)
     {
         slots.assign(list.pairs() * q_, Quad{});
-#pragma omp parallel for schedule(static) if (parallel)
-        for (std::size_t s = 0; s < n; ++s) {
-            const std::size_t i = std::size_t(id[s]);
-            Index e = carry_start_[i];
-            const Index e1 = carry_start_[i + 1];
-            for (Index k = list.start[s]; k < list.start[s + 1] && e < e1; ++k) {
-                const Index j = id[std::size_t(list.partner[std::size_t(k)])];
-                while (e < e1 && carry_partner_[std::size_t(e)] < j) ++e;
-                if (e < e1 && carry_partner_[std::size_t(e)] == j)
-                    for (std::size_t q = 0; q < q_; ++q) slots[std::size_t(k) * q_ + q] = carry_rec_[std::size_t(e) * q_ + q];
+        in_team(parallel, [&] {
+#pragma omp for schedule(static)
+            for (std::size_t s = 0; s < n; ++s) {
+                const std::size_t i = std::size_t(id[s]);
+                Index e = carry_start_[i];
+                const Index e1 = carry_start_[i + 1];
+                for (Index k = list.start[s]; k < list.start[s + 1] && e < e1; ++k) {
+                    const Index j = id[std::size_t(list.partner[std::size_t(k)])];
+                    while (e < e1 && carry_partner_[std::size_t(e)] < j) ++e;
+                    if (e < e1 && carry_partner_[std::size_t(e)] == j)
+                        for (std::size_t q = 0; q < q_; ++q) slots[std::size_t(k) * q_ + q] = carry_rec_[std::size_t(e) * q_ + q];
+                }
             }
-        }
+        });
     }
 
     // The carried stretches are no longer needed once every rebuild that may read them is done (held

@@ -14,6 +14,7 @@
 #include "demmat/variant.hpp"
 #include "heap_bytes.hpp"
 #include "quads.hpp"
+#include "team.hpp"
 
 namespace demmat::fast {
 
@@ -197,13 +198,15 @@ public:
             std::vector<double>& col = *arr;
             double* dst = tmp_.data();
             const double* src = col.data();
-#pragma omp parallel for schedule(static) if (parallel)
-            for (std::size_t s = 0; s < n; ++s) {
-                const std::size_t o = from(s);
-                dst[s] = src[o];
-                dst[n + s] = src[n + o];
-                dst[2 * n + s] = src[2 * n + o];
-            }
+            in_team(parallel, [&] {
+#pragma omp for schedule(static)
+                for (std::size_t s = 0; s < n; ++s) {
+                    const std::size_t o = from(s);
+                    dst[s] = src[o];
+                    dst[n + s] = src[n + o];
+                    dst[2 * n + s] = src[2 * n + o];
+                }
+            });
             col.swap(tmp_);
         }
         for (auto* arr : {&r, &m, &inertia}) {

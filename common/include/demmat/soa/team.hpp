@@ -30,6 +30,26 @@ inline std::pair<std::size_t, std::size_t> thread_range(std::size_t n)
     return {n * t / nt, n * (t + 1) / nt};
 }
 
+// Runs body() on a team of threads where `parallel` asks for one and OpenMP may give more than one
+// thread; otherwise on this thread alone, outside any parallel region. libgomp makes a team of one all
+// the same (`#pragma omp parallel if (false)` too), and every barrier of a team (a region's end, a
+// single's, an explicit one) ends in a futex wake, a system call, each step. Alone, the body's directives
+// are orphaned and cost nothing: a barrier or a single is no wait, a worksharing loop runs its whole
+// range, thread_count() is 1. What a body sums across threads it adds to shared atomics, not through a
+// reduction clause, so that both ways run the same code.
+template <class Body>
+void in_team(bool parallel, Body&& body)
+{
+#ifdef _OPENMP
+    if (parallel && omp_get_max_threads() > 1) {
+#pragma omp parallel
+        body();
+        return;
+    }
+#endif
+    body();
+}
+
 // Where each of `team` threads' shares ends (thread_range's ends).
 inline std::size_t range_end(std::size_t n, std::size_t u, std::size_t team) { return n * (u + 1) / team; }
 
