@@ -19,8 +19,8 @@ using namespace demmat::fast;
 
 namespace {
 
-// n particles, each owning slots with a few random partners of higher index within `window`; as_j
-// lists each particle's slots as partner in slot order (ascending owner).
+// n particles (ids their storage indices), each storing slots with a few random partners of higher index
+// within `window`, as their owner; as_i and as_j as the list's build makes them.
 NeighbourList random_list(std::size_t n, std::size_t window, std::mt19937_64& rng)
 {
     NeighbourList list;
@@ -40,12 +40,9 @@ NeighbourList random_list(std::size_t n, std::size_t window, std::mt19937_64& rn
         }
     }
     list.start[n] = Index(list.partner.size());
-    list.jstart.assign(n + 1, 0);
-    for (Index q : list.partner) ++list.jstart[std::size_t(q) + 1];
-    for (std::size_t s = 0; s < n; ++s) list.jstart[s + 1] += list.jstart[s];
-    list.as_j.resize(list.partner.size());
-    std::vector<Index> fill(list.jstart.begin(), list.jstart.end() - 1);
-    for (std::size_t k = 0; k < list.partner.size(); ++k) list.as_j[std::size_t(fill[std::size_t(list.partner[k])]++)] = Index(k);
+    std::vector<Index> id(n);
+    for (std::size_t s = 0; s < n; ++s) id[s] = Index(s);
+    list.index_by_particle(id, false);
     return list;
 }
 
@@ -106,7 +103,7 @@ TEST(CanonicalSums, BothGroupFormsGiveEachParticleTheBitsOfItsSumAlone)
 
     std::size_t with_slots = 0;
     for (std::size_t s = 0; s < n; ++s) {
-        with_slots += list.jstart[s + 1] > list.jstart[s] && list.start[s + 1] > list.start[s];
+        with_slots += list.jstart[s + 1] > list.jstart[s] && list.istart[s + 1] > list.istart[s];
         EXPECT_EQ(bits_of(eight, s), bits_of(alone, s)) << "eight lanes, particle " << s;
         EXPECT_EQ(bits_of(quads, s), bits_of(alone, s)) << "quads, particle " << s;
     }

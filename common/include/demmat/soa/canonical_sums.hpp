@@ -1,7 +1,7 @@
 #pragma once
 // The fast variant's canonical sums: each particle sums, in the order of physics.md §6, the slots where
-// it is j (partners of lower id, ascending), then its own slots (partners of higher id, ascending), then
-// its walls, so that its bits are those of arrays whichever thread sums it, and when. The slots come
+// it is j (partners of lower id, ascending), then those where it is i (partners of higher id, ascending),
+// then its walls, so that its bits are those of arrays whichever thread sums it, and when. The slots come
 // from a thread's ring (the sweep, canonical_sweep.hpp) or from the list of all slots. At each rebuild
 // this plans, for the sweep, which chunk's slots each sum waits for, and cuts each chunk's schedule into
 // groups of kGroup particles summed side by side.
@@ -57,7 +57,7 @@ public:
         std::size_t bytes() const { return heap_bytes(start, order, group_start, groups, table); }
     };
 
-    // Per particle, the chunks of its slots' first and last owners.
+    // Per particle, the chunks where its first and last slots are stored.
     std::vector<Index> first_chunk, last_chunk;
     // The upward threads' schedule (by last chunk) and the downward threads' (by first chunk, planned
     // only for a sweep of two threads or more: plan_first()).
@@ -68,14 +68,17 @@ public:
 
     static std::size_t chunks(std::size_t n) { return (n + kChunk - 1) / kChunk; }
 
-    // After a canonical list is built: a particle's sum needs the slots of the chunks from that of the
-    // first owner of its slots to that of the last (itself for its own, its partners of lower id for
-    // the others). The two schedules are planned side by side on a team of two or more (the list is
+    // After a canonical list is built: a particle's sum needs the slots of the chunks from the first
+    // where one of its slots is stored to the last (its own, or its partners' below it in storage: a
+    // slot is stored with the pair's particle that comes first). The two schedules are planned side by side on a team of two or more (the list is
     // rebuilt in the timed loop); a team of one plans only the upward one, all that a sweep of one
     // thread reads.
     void plan(const NeighbourList& list, std::size_t n, bool parallel)
     {
         const Index* owner = list.owner.data();
+        const Index* partner = list.partner.data();
+        const Index* istart = list.istart.data();
+        const Index* as_i = list.as_i.data();
         const Index* jstart = list.jstart.data();
         const Index* as_j = list.as_j.data();
         const Index* pstart = list.start.data();
@@ -85,11 +88,13 @@ public:
         std::size_t reach = 0;  // the most slots from the start of a particle's first chunk to the end of its last
         for (std::size_t s = 0; s < n; ++s) {
             std::size_t first = s, last = s;
-            for (Index e = jstart[s]; e < jstart[s + 1]; ++e) {
-                const std::size_t o = std::size_t(owner[as_j[e]]);
-                first = std::min(first, o);
-                last = std::max(last, o);
-            }
+            auto stored_at = [&](Index k) {  // the particle slot k is stored with
+                const std::size_t at = std::size_t(std::min(owner[k], partner[k]));
+                first = std::min(first, at);
+                last = std::max(last, at);
+            };
+            for (Index e = jstart[s]; e < jstart[s + 1]; ++e) stored_at(as_j[e]);
+            for (Index e = istart[s]; e < istart[s + 1]; ++e) stored_at(as_i[e]);
             first /= kChunk;
             last /= kChunk;
             first_chunk[s] = Index(first);
@@ -133,9 +138,10 @@ public:
         const std::size_t mask = from.mask, split = from.split;
         auto at = [=](std::size_t k) { return (k < split ? lo : hi) + 9 * (k & mask); };  // slot k
         const Index* as_j = list.as_j.data();
+        const Index* as_i = list.as_i.data();
         Quad f{}, tq{};
         for (Index e = list.jstart[s]; e < list.jstart[s + 1]; ++e) add_as_j(at(std::size_t(as_j[e])), f, tq);
-        for (Index k = list.start[s]; k < list.start[s + 1]; ++k) add_as_i(at(std::size_t(k)), f, tq);
+        for (Index e = list.istart[s]; e < list.istart[s + 1]; ++e) add_as_i(at(std::size_t(as_i[e])), f, tq);
         walls.add(s, f, tq);
         p.store_sum(s, f, tq);
     }
@@ -265,7 +271,8 @@ private:
         table.clear();
         const Index* jstart = list.jstart.data();
         const Index* as_j = list.as_j.data();
-        const Index* pstart = list.start.data();
+        const Index* istart = list.istart.data();
+        const Index* as_i = list.as_i.data();
         const std::size_t mask = ring_slots - 1;
         auto offset = [mask](Index k) { return std::uint32_t((std::size_t(k) & mask) * sizeof(Slot)); };
         const std::uint32_t zeros = std::uint32_t(ring_slots * sizeof(Slot));
@@ -286,7 +293,7 @@ private:
                     g.grain[l] = s;
                     if (s < 0) continue;
                     g.as_j = std::max(g.as_j, jstart[s + 1] - jstart[s]);
-                    g.as_i = std::max(g.as_i, pstart[s + 1] - pstart[s]);
+                    g.as_i = std::max(g.as_i, istart[s + 1] - istart[s]);
                 }
                 for (Index e = 0; e < g.as_j; ++e)
                     for (int l = 0; l < kGroup; ++l) {
@@ -296,7 +303,7 @@ private:
                 for (Index e = 0; e < g.as_i; ++e)
                     for (int l = 0; l < kGroup; ++l) {
                         const Index s = g.grain[l];
-                        table.push_back(s >= 0 && e < pstart[s + 1] - pstart[s] ? offset(pstart[s] + e) : zeros);
+                        table.push_back(s >= 0 && e < istart[s + 1] - istart[s] ? offset(as_i[istart[s] + e]) : zeros);
                     }
                 groups.push_back(g);
             }

@@ -1,8 +1,11 @@
 #pragma once
 // The fast variant's neighbour list with a skin: each pair closer than R_i + R_j + skin is listed once,
-// under its lower-id particle (the law's i, the owner), in a slot of its own: the pairs of owner s are
-// slots [start[s], start[s + 1]). For the canonical order the partners are in ascending id, and each
-// particle also has the slots where it is the partner, by ascending id of the owner (as_j).
+// in a slot of its own, under the particle that comes first in storage: the slots stored at s are
+// [start[s], start[s + 1]), so each chunk of the storage order has its slots together. Each slot names
+// the pair by the law's roles: owner the lower id (i), partner the higher (j). For the canonical order
+// each particle also has the slots where it is i, by ascending id of the partner (as_i), and those where
+// it is j, by ascending id of the owner (as_j). Stored with the storage-earlier particle, a sum reaches
+// back only to its partners below it in storage, never above: half the slots a lower-id rule kept live.
 #include <algorithm>
 #include <cstddef>
 #include <utility>
@@ -32,17 +35,18 @@ inline void bucket_sort(const std::vector<Index>& key, std::size_t buckets, std:
 
 class NeighbourList {
 public:
-    std::vector<Index> start, partner, owner;  // the slots of each owner; each slot's partner and owner
-    std::vector<Index> jstart, as_j;           // canonical: the slots where each particle is the partner
+    std::vector<Index> start, partner, owner;  // the slots stored at each particle; each slot's j and i (by id)
+    std::vector<Index> istart, as_i;           // canonical: the slots where each particle is i, partners ascending
+    std::vector<Index> jstart, as_j;           // canonical: the slots where each particle is j, owners ascending
     // Per thread of the last build: the storage range its slots reach (its particles and their partners).
     std::vector<std::pair<std::size_t, std::size_t>> spans;
 
     std::size_t pairs() const { return partner.size(); }
 
     // Lists the pairs of the particles p, in the cell order `cells`, closer than R_i + R_j + skin. One
-    // scan of the cells: each thread lists its particles' partners in a buffer of its own, then (after
-    // the counts' prefix sum) copies them into place. Canonical: partners by ascending id, and as_j;
-    // otherwise partners in the scan's order (ascending storage).
+    // scan of the cells: each thread lists its particles' later neighbours in storage in a buffer of its
+    // own, then (after the counts' prefix sum) copies them into place, in the scan's order (ascending
+    // storage). Canonical: as_i and as_j too.
     void build(const Particles& p, const CellOrder& cells, double skin, bool canonical, bool parallel)
     {
         const std::size_t n = p.n;
@@ -50,7 +54,7 @@ public:
         const std::vector<Index>& id = p.id;
         // may_touch with each radius grown by skin/2: pairs closer than R_i + R_j + skin, with the law's margin.
         auto near = [&](std::size_t s, std::size_t q) {
-            return id[q] > id[s] && may_touch(p.get(p.x, s), p.get(p.x, q), p.r[s] + half_skin, p.r[q] + half_skin);
+            return q > s && may_touch(p.get(p.x, s), p.get(p.x, q), p.r[s] + half_skin, p.r[q] + half_skin);
         };
         start.assign(n + 1, 0);
         Index* pstart = start.data();
@@ -84,25 +88,36 @@ public:
                 span_hi = std::max(span_hi, std::size_t(q) + 1);
             }
             spans[std::size_t(thread_index())] = {span_lo, span_hi};
-            for (std::size_t s = lo; s < hi; ++s) {
-                std::fill(powner + pstart[s], powner + pstart[s + 1], Index(s));
-                if (canonical)
-                    std::sort(ppartner + pstart[s], ppartner + pstart[s + 1], [&id](Index x, Index y) { return id[x] < id[y]; });
-            }
+            for (std::size_t s = lo; s < hi; ++s)
+                for (Index k = pstart[s]; k < pstart[s + 1]; ++k) {
+                    const Index q = ppartner[k];  // the law's i is the lower id
+                    const bool swap = id[std::size_t(q)] < id[s];
+                    powner[k] = swap ? q : Index(s);
+                    ppartner[k] = swap ? Index(s) : q;
+                }
         });
-        if (!canonical) return;
+        if (canonical) index_by_particle(id, parallel);
+    }
+
+    // as_i and as_j from owner and partner: each particle's slots as i, by ascending partner id, and as
+    // j, by ascending owner id (ids are unique, so the order is total).
+    void index_by_particle(const std::vector<Index>& id, bool parallel)
+    {
+        const std::size_t n = start.size() - 1;
+        bucket_sort(owner, n, istart, as_i);
         bucket_sort(partner, n, jstart, as_j);
-        const Index* pjstart = jstart.data();
         const Index* powner = owner.data();
-        Index* pas_j = as_j.data();
+        const Index* ppartner = partner.data();
         in_team(parallel, [&] {
 #pragma omp for schedule(static)
-            for (std::size_t s = 0; s < n; ++s)
-                std::sort(pas_j + pjstart[s], pas_j + pjstart[s + 1], [&](Index x, Index y) { return id[powner[x]] < id[powner[y]]; });
+            for (std::size_t s = 0; s < n; ++s) {
+                std::sort(as_i.begin() + istart[s], as_i.begin() + istart[s + 1], [&](Index x, Index y) { return id[ppartner[x]] < id[ppartner[y]]; });
+                std::sort(as_j.begin() + jstart[s], as_j.begin() + jstart[s + 1], [&](Index x, Index y) { return id[powner[x]] < id[powner[y]]; });
+            }
         });
     }
 
-    std::size_t bytes() const { return heap_bytes(start, partner, owner, jstart, as_j, spans, scan_); }
+    std::size_t bytes() const { return heap_bytes(start, partner, owner, istart, as_i, jstart, as_j, spans, scan_); }
 
 private:
     std::vector<std::vector<Index>> scan_;  // per thread: partners found by the scan

@@ -66,10 +66,11 @@ class PairKernel {
     static constexpr std::size_t kQ = std::size_t(stretch_quads<M>);
 
 public:
-    // From FastOptions::prefetch_from particles on, the kernel prefetches its partners' records
-    // kPrefetch candidates ahead (and in fast_unordered their loads): owners come in storage order,
-    // which the hardware prefetches, partners from anywhere in the sweep's reach, which it does not, and
-    // in large beds the records no longer stay in the caches between force passes.
+    // From FastOptions::prefetch_from particles on, the kernel prefetches the far particle's record of
+    // each slot kPrefetch candidates ahead (and in fast_unordered its load): a slot is stored with the
+    // pair's particle that comes first in storage, whose records come in order, which the hardware
+    // prefetches; the other (the later, max(owner, partner)) lies anywhere in the sweep's reach, which it
+    // does not, and in large beds the records no longer stay in the caches between force passes.
     static constexpr std::size_t kPrefetch = 128;
 
     PairKernel(const NeighbourList& list, const Particles& p, const LawInputs& law, Quad* stretches, bool prefetch)
@@ -102,10 +103,11 @@ public:
                 if (prefetch_) {
                     const std::size_t ahead = std::min(k + kPrefetch, pairs_ - kLanes);
                     for (int l = 0; l < kLanes; ++l) {
-                        const char* rec = reinterpret_cast<const char*>(&kin_[partner_[ahead + std::size_t(l)]]);
+                        const Index far = std::max(owner_[ahead + std::size_t(l)], partner_[ahead + std::size_t(l)]);
+                        const char* rec = reinterpret_cast<const char*>(&kin_[far]);
                         __builtin_prefetch(rec);
                         __builtin_prefetch(rec + 64);
-                        if constexpr (!Canonical) __builtin_prefetch(&load[partner_[ahead + std::size_t(l)]], 1);
+                        if constexpr (!Canonical) __builtin_prefetch(&load[far], 1);
                     }
                 }
                 Lanes a[4], b[4];

@@ -90,8 +90,8 @@ public:
     }
     std::size_t quads() const { return q_; }
 
-    // Before a re-sort: every slot with a bit set, keyed by (owner id, partner id); each owner's
-    // partners come ascending (the canonical list), so each owner's entries do.
+    // Before a re-sort: every slot with a bit set, keyed by (owner id, partner id); each particle's slots
+    // as owner come by ascending partner (as_i, the canonical list), so each owner's entries do.
     void collect(const NeighbourList& list, const std::vector<Index>& id, std::size_t n)
     {
         carry_start_.assign(n + 1, 0);
@@ -104,15 +104,16 @@ public:
             return false;
         };
         for (std::size_t s = 0; s < n; ++s)
-            for (Index k = list.start[s]; k < list.start[s + 1]; ++k)
-                if (live(std::size_t(k))) ++carry_start_[std::size_t(id[s]) + 1];
+            for (Index e = list.istart[s]; e < list.istart[s + 1]; ++e)
+                if (live(std::size_t(list.as_i[std::size_t(e)]))) ++carry_start_[std::size_t(id[s]) + 1];
         for (std::size_t i = 0; i < n; ++i) carry_start_[i + 1] += carry_start_[i];
         const std::size_t total = std::size_t(carry_start_[n]);
         carry_partner_.resize(total);
         carry_rec_.resize(total * q_);
         fill_.assign(carry_start_.begin(), carry_start_.end() - 1);
         for (std::size_t s = 0; s < n; ++s)
-            for (Index k = list.start[s]; k < list.start[s + 1]; ++k) {
+            for (Index e0 = list.istart[s]; e0 < list.istart[s + 1]; ++e0) {
+                const Index k = list.as_i[std::size_t(e0)];
                 if (!live(std::size_t(k))) continue;
                 const std::size_t e = std::size_t(fill_[std::size_t(id[s])]++);
                 carry_partner_[e] = id[std::size_t(list.partner[std::size_t(k)])];
@@ -150,7 +151,8 @@ public:
                 const std::size_t i = std::size_t(id[s]);
                 Index e = carry_start_[i];
                 const Index e1 = carry_start_[i + 1];
-                for (Index k = list.start[s]; k < list.start[s + 1] && e < e1; ++k) {
+                for (Index a = list.istart[s]; a < list.istart[s + 1] && e < e1; ++a) {
+                    const Index k = list.as_i[std::size_t(a)];
                     const Index j = id[std::size_t(list.partner[std::size_t(k)])];
                     while (e < e1 && carry_partner_[std::size_t(e)] < j) ++e;
                     if (e < e1 && carry_partner_[std::size_t(e)] == j)
@@ -175,7 +177,8 @@ public:
     void save(const NeighbourList& list, const Particles& p, std::vector<ContactStretch>& out) const
     {
         for (std::size_t s = 0; s < p.n; ++s)
-            for (Index k = list.start[s]; k < list.start[s + 1]; ++k) {
+            for (Index e = list.istart[s]; e < list.istart[s + 1]; ++e) {
+                const Index k = list.as_i[std::size_t(e)];
                 const std::size_t q = std::size_t(list.partner[std::size_t(k)]);
                 const Quad& a = p.kin[s].xr;
                 const Quad& b = p.kin[q].xr;
