@@ -70,9 +70,9 @@ public:
 
     // After a canonical list is built: a particle's sum needs the slots of the chunks from the first
     // where one of its slots is stored to the last (its own, or its partners' below it in storage: a
-    // slot is stored with the pair's particle that comes first). The two schedules are planned side by side on a team of two or more (the list is
-    // rebuilt in the timed loop); a team of one plans only the upward one, all that a sweep of one
-    // thread reads.
+    // slot is stored with the pair's particle that comes first). The two schedules are planned side by
+    // side on a team of two or more (the list is rebuilt in the timed loop); a team of one plans only
+    // the upward one, all that a sweep of one thread reads.
     void plan(const NeighbourList& list, std::size_t n, bool parallel)
     {
         const Index* owner = list.owner.data();

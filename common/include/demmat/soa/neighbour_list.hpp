@@ -5,7 +5,7 @@
 // the pair by the law's roles: owner the lower id (i), partner the higher (j). For the canonical order
 // each particle also has the slots where it is i, by ascending id of the partner (as_i), and those where
 // it is j, by ascending id of the owner (as_j). Stored with the storage-earlier particle, a sum reaches
-// back only to its partners below it in storage, never above: half the slots a lower-id rule kept live.
+// back only to its partners below it in storage, never above, as it did with the slots under the lower id.
 #include <algorithm>
 #include <cstddef>
 #include <utility>
