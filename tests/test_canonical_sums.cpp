@@ -3,13 +3,15 @@
 // targets), must give each particle the bits of its sum alone (sum_particle), the order of physics.md
 // §6. A build runs only the form its target's width picks, so the equivalence tests see one of them on
 // a given machine; this runs both here, on a list with random slot values of mixed magnitudes, where
-// any change of order, sign or lane changes bits.
+// any change of order, sign or lane changes bits. The sum alone is checked in turn against the order
+// written out from every slot of the list, with ids that do not follow storage.
 #include <gtest/gtest.h>
 
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
+#include <utility>
 #include <vector>
 
 #include "demmat/soa/canonical_sums.hpp"
@@ -19,10 +21,14 @@ using namespace demmat::fast;
 
 namespace {
 
-// n particles (ids their storage indices), each storing slots with a few random partners of higher index
-// within `window`, as their owner; as_i and as_j as the list's build makes them.
-NeighbourList random_list(std::size_t n, std::size_t window, std::mt19937_64& rng)
+// n particles with ids in a random order (storage is not id order), each storing slots with a few
+// random partners of higher index within `window`, the lower id of each pair its owner (the law's i);
+// as_i and as_j as the list's build makes them.
+NeighbourList random_list(std::size_t n, std::size_t window, std::mt19937_64& rng, std::vector<Index>& id)
 {
+    id.resize(n);
+    for (std::size_t s = 0; s < n; ++s) id[s] = Index(s);
+    std::shuffle(id.begin(), id.end(), rng);
     NeighbourList list;
     list.start.assign(n + 1, 0);
     std::uniform_int_distribution<std::size_t> count(0, 7), offset(1, window);
@@ -33,15 +39,13 @@ NeighbourList random_list(std::size_t n, std::size_t window, std::mt19937_64& rn
             const std::size_t q = s + offset(rng);
             if (q < n && std::find(partners.begin(), partners.end(), q) == partners.end()) partners.push_back(q);
         }
-        std::sort(partners.begin(), partners.end());
         for (std::size_t q : partners) {
-            list.owner.push_back(Index(s));
-            list.partner.push_back(Index(q));
+            const bool swap = id[q] < id[s];
+            list.owner.push_back(Index(swap ? q : s));
+            list.partner.push_back(Index(swap ? s : q));
         }
     }
     list.start[n] = Index(list.partner.size());
-    std::vector<Index> id(n);
-    for (std::size_t s = 0; s < n; ++s) id[s] = Index(s);
     list.index_by_particle(id, false);
     return list;
 }
@@ -66,7 +70,8 @@ TEST(CanonicalSums, BothGroupFormsGiveEachParticleTheBitsOfItsSumAlone)
 {
     std::mt19937_64 rng(12345);
     const std::size_t n = 3 * CanonicalSums::kChunk + 17;  // several chunks, the last one partial
-    const NeighbourList list = random_list(n, 60, rng);
+    std::vector<Index> id;
+    const NeighbourList list = random_list(n, 60, rng, id);
     ASSERT_GT(list.pairs(), 4 * n / 2);
     CanonicalSums sums;
     sums.plan(list, n, false);
@@ -108,4 +113,39 @@ TEST(CanonicalSums, BothGroupFormsGiveEachParticleTheBitsOfItsSumAlone)
         EXPECT_EQ(bits_of(quads, s), bits_of(alone, s)) << "quads, particle " << s;
     }
     EXPECT_GT(with_slots, n / 2);  // most sums read slots both as j and as i
+
+    // sum_particle against physics.md §6 written out: every slot of particle s, by the other particle's
+    // id (as j below s's id, the force subtracted and t_j added; as i above, f and t_i added).
+    std::vector<std::vector<std::pair<Index, std::size_t>>> mine(n);  // (other's id, slot)
+    for (std::size_t k = 0; k < list.pairs(); ++k) {
+        const auto i = std::size_t(list.owner[k]), j = std::size_t(list.partner[k]);
+        ASSERT_LT(id[i], id[j]);
+        mine[i].push_back({id[j], k});
+        mine[j].push_back({id[i], k});
+    }
+    std::size_t swapped = 0;  // slots whose i comes later in storage than their j
+    for (std::size_t k = 0; k < list.pairs(); ++k) swapped += list.owner[k] > list.partner[k];
+    EXPECT_GT(swapped, list.pairs() / 4);
+    for (std::size_t s = 0; s < n; ++s) {
+        std::sort(mine[s].begin(), mine[s].end());
+        double f[3] = {0.0, 0.0, 0.0}, t[3] = {0.0, 0.0, 0.0};
+        for (const auto& [other, k] : mine[s]) {
+            const Slot& slot = ring[k & mask];
+            const bool as_j = other < id[s];
+            const Vec3d& tq = as_j ? slot.tj : slot.ti;
+            const double fc[3] = {slot.f.x, slot.f.y, slot.f.z}, tc[3] = {tq.x, tq.y, tq.z};
+            for (int c = 0; c < 3; ++c) {
+                f[c] = as_j ? f[c] - fc[c] : f[c] + fc[c];
+                t[c] = t[c] + tc[c];
+            }
+        }
+        std::vector<std::uint64_t> want;
+        for (const double* a : {f, t})
+            for (int c = 0; c < 3; ++c) {
+                std::uint64_t b;
+                std::memcpy(&b, &a[c], sizeof b);
+                want.push_back(b);
+            }
+        EXPECT_EQ(bits_of(alone, s), want) << "particle " << s << " against the canonical order written out";
+    }
 }
