@@ -77,15 +77,16 @@ TEST(CanonicalSums, BothGroupFormsGiveEachParticleTheBitsOfItsSumAlone)
     sums.plan(list, n, false);
 
     // The ring as the sweep leaves it after the last chunk: slot k at k & mask (a slot overwritten by a
-    // later one is read alike by every form), the slot of zeros at ring_slots, one more past it.
+    // later one is read alike by every form), the slot of zeros at ring_slots.
     const std::size_t mask = sums.ring_slots - 1;
-    std::vector<Slot> ring(sums.ring_slots + 2, Slot{});
+    SlotStore ring;
+    ring.assign(sums.ring_slots + 1);
     std::uniform_real_distribution<double> mantissa(-1.0, 1.0);
     std::uniform_int_distribution<int> exponent(-30, 30);
     auto value = [&] { return std::ldexp(mantissa(rng), exponent(rng)); };
     for (std::size_t k = 0; k < list.pairs(); ++k) {
-        Slot& s = ring[k & mask];
-        for (Vec3d* v : {&s.tj, &s.f, &s.ti}) *v = {value(), value(), value()};
+        for (double& v : ring.line[k & mask].v) v = value();
+        ring.tz[k & mask] = value();
     }
 
     WallContacts walls;
@@ -96,12 +97,12 @@ TEST(CanonicalSums, BothGroupFormsGiveEachParticleTheBitsOfItsSumAlone)
         p->f.assign(3 * n, -1.0);
         p->t.assign(3 * n, -1.0);
     }
-    const SlotSource from{ring.data(), ring.data(), mask, 0};
+    const SlotSource from{ring.view(), ring.view(), mask, 0};
     for (std::size_t s = 0; s < n; ++s) sums.sum_particle(s, from, list, walls, alone);
     std::size_t grouped = 0;
     for (const CanonicalSums::Group& g : sums.by_last.groups) {
-        sums.sum_group_eight(sums.by_last, g, ring.data(), walls, eight);
-        sums.sum_group_quads(sums.by_last, g, ring.data(), walls, quads);
+        sums.sum_group_eight(sums.by_last, g, ring.view(), walls, eight);
+        sums.sum_group_quads(sums.by_last, g, ring.view(), walls, quads);
         grouped += std::size_t(g.count);
     }
     ASSERT_EQ(grouped, n);  // every particle is in one group
@@ -130,10 +131,10 @@ TEST(CanonicalSums, BothGroupFormsGiveEachParticleTheBitsOfItsSumAlone)
         std::sort(mine[s].begin(), mine[s].end());
         double f[3] = {0.0, 0.0, 0.0}, t[3] = {0.0, 0.0, 0.0};
         for (const auto& [other, k] : mine[s]) {
-            const Slot& slot = ring[k & mask];
+            const Slot& slot = ring.line[k & mask];
             const bool as_j = other < id[s];
-            const Vec3d& tq = as_j ? slot.tj : slot.ti;
-            const double fc[3] = {slot.f.x, slot.f.y, slot.f.z}, tc[3] = {tq.x, tq.y, tq.z};
+            const Vec3d fv = slot.f(), tq = as_j ? slot.tj() : ring.ti(k & mask);
+            const double fc[3] = {fv.x, fv.y, fv.z}, tc[3] = {tq.x, tq.y, tq.z};
             for (int c = 0; c < 3; ++c) {
                 f[c] = as_j ? f[c] - fc[c] : f[c] + fc[c];
                 t[c] = t[c] + tc[c];

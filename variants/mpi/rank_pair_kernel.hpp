@@ -57,7 +57,7 @@ public:
         fill(list_, pairs, 0, counted);
         fill(ghost_list_, pairs, counted, pairs.size());
         ring_size_ = std::bit_ceil(std::max<std::size_t>(reach, 1));
-        slots_.assign(ring_size_ + (pairs.size() - counted) + 1, fast::Slot{});  // the ring, the ghosts' pairs, a zero
+        slots_.assign(ring_size_ + (pairs.size() - counted) + 1);  // the ring, the ghosts' pairs, a zero
         if constexpr (kQ > 0) {
             stretches_.assign(pairs.size() * kQ, fast::Quad{});
             for (std::size_t k = 0; k < pairs.size(); ++k)
@@ -114,7 +114,7 @@ public:
     {
         if (ghost_list_.pairs() == 0) return;
         const fast::PairKernel<PairModel<M>> kernel(ghost_list_, soa_, law_, stretch_at(counted_), false);  // too few to prefetch
-        kernel.template run<true>(0, ghost_list_.pairs(), nullptr, fast::SlotSink{slots_.data() + ring_size_, ~std::size_t(0), nullptr});
+        kernel.template run<true>(0, ghost_list_.pairs(), nullptr, fast::SlotSink{slots_.view(ring_size_), ~std::size_t(0), {}});
     }
 
     // Counted slots [begin, end), into the ring; returns the contacts among them.
@@ -122,16 +122,16 @@ public:
     {
         if (begin >= end) return 0;
         const fast::PairKernel<PairModel<M>> kernel(list_, soa_, law_, stretch_at(0), prefetch_ && list_.pairs() >= fast::kLanes);
-        return kernel.template run<true>(begin, end, nullptr, fast::SlotSink{slots_.data(), ring_size_ - 1, nullptr});
+        return kernel.template run<true>(begin, end, nullptr, fast::SlotSink{slots_.view(), ring_size_ - 1, {}});
     }
 
     // Where pair k's slot lies in slots(): valid from the run that wrote it until the ring comes round.
     // The last position holds zeros.
     std::int32_t position(std::size_t k) const { return std::int32_t(k < counted_ ? k & (ring_size_ - 1) : ring_size_ + (k - counted_)); }
     std::int32_t zero_position() const { return std::int32_t(slots_.size() - 1); }
-    const fast::Slot* slots() const { return slots_.data(); }
+    const fast::SlotStore& slots() const { return slots_; }
 
-    std::size_t memory_bytes() const { return list_.bytes() + ghost_list_.bytes() + soa_.bytes() + fast::heap_bytes(slots_, stretches_); }
+    std::size_t memory_bytes() const { return list_.bytes() + ghost_list_.bytes() + soa_.bytes() + slots_.bytes() + fast::heap_bytes(stretches_); }
 
 private:
     fast::Quad* stretch_at(std::size_t k) { return kQ > 0 ? stretches_.data() + k * kQ : nullptr; }
@@ -150,7 +150,7 @@ private:
     fast::LawInputs law_;
     fast::Particles soa_;         // only the kernel's records (kin) are used
     fast::NeighbourList list_, ghost_list_;  // the counted pairs, the others; only owners and partners are used
-    std::vector<fast::Slot> slots_;  // a ring for the counted pairs, then a slot per other pair, then zeros
+    fast::SlotStore slots_;  // a ring for the counted pairs, then a slot per other pair, then zeros
     std::vector<fast::Quad> stretches_;  // kQ per pair (a law with memory), in the list's order
     std::size_t counted_ = 0, ring_size_ = 1;
     bool prefetch_ = false;

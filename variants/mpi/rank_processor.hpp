@@ -233,18 +233,18 @@ public:
     {
         const RankSumTable::Group& grp = sums_.group(l0 / kSumGroup);
         const std::int32_t* at = sums_.table(grp);
-        const fast::Slot* slot = kernel_.slots();
+        const fast::SlotStore& slot = kernel_.slots();
         for (std::size_t e = 0; e < grp.as_j; ++e, at += kSumGroup)
             for (std::size_t g = 0; g < kSumGroup; ++g) {
-                const fast::Slot& c = slot[at[g]];
-                f[g] = f[g] + (-c.f);
-                if constexpr (M::rotation) t[g] = t[g] + c.tj;
+                const fast::Slot& c = slot.line[std::size_t(at[g])];
+                f[g] = f[g] + (-c.f());
+                if constexpr (M::rotation) t[g] = t[g] + c.tj();
             }
         for (std::size_t e = 0; e < grp.as_i; ++e, at += kSumGroup)
             for (std::size_t g = 0; g < kSumGroup; ++g) {
-                const fast::Slot& c = slot[at[g]];
-                f[g] = f[g] + c.f;
-                if constexpr (M::rotation) t[g] = t[g] + c.ti;
+                const fast::Slot& c = slot.line[std::size_t(at[g])];
+                f[g] = f[g] + c.f();
+                if constexpr (M::rotation) t[g] = t[g] + slot.ti(std::size_t(at[g]));
             }
     }
 

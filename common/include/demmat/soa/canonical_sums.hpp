@@ -24,11 +24,10 @@
 
 namespace demmat::fast {
 
-// Where a sum reads slot k: lo[k & mask] below `split`, hi[k & mask] from it on (a ring: mask + 1 slots,
-// plus one; the whole list: mask all ones).
+// Where a sum reads slot k: lo at k & mask below `split`, hi at k & mask from it on (a ring: mask + 1
+// slots, plus the slot of zeros; the whole list: mask all ones).
 struct SlotSource {
-    const Slot* lo;
-    const Slot* hi;
+    SlotView lo, hi;
     std::size_t mask, split;
 };
 
@@ -36,7 +35,8 @@ class CanonicalSums {
 public:
     static constexpr std::size_t kChunk = 128;  // particles per chunk of the sweep
     static constexpr int kGroup = 4;            // particles per sum group (sum_group)
-    // Where a slot's t_j, f and t_i start (pair_kernel.hpp's Slot), in doubles.
+    // Where t_j, f and t_i start in a slot's line (pair_kernel.hpp's Slot), in doubles; t_i.z is not in
+    // the line.
     static constexpr std::size_t kTorqueJ = 0, kForce = 3, kTorqueI = 6;
 
     // A group of sums (sum_group): its particles (-1: none), the longest of their lists as j and as i,
@@ -49,7 +49,8 @@ public:
 
     // One of the sweep's two schedules (by each particle's last chunk, or by its first): the particles
     // by chunk (order, from start[chunk]), each chunk's groups (from group_start[chunk]) and their
-    // tables of ring offsets (schedule()).
+    // tables of ring places (schedule(): 8·(k & mask) for slot k, the byte where its t_i.z lies, and an
+    // eighth of where its line does).
     struct Schedule {
         std::vector<Index> start, order, group_start;
         std::vector<Group> groups;
@@ -103,9 +104,9 @@ public:
             reach = std::max(reach, std::size_t(pstart[std::min(n, (last + 1) * kChunk)] - pstart[first * kChunk]));
         }
         ring_slots = std::bit_ceil(std::max<std::size_t>(reach, 1));
-        // The tables hold byte offsets into a ring as 32-bit words.
-        if ((ring_slots + 2) * sizeof(Slot) > std::size_t(UINT32_MAX))
-            throw CapacityError(fmt::format("the fast variant's canonical sweep needs a ring of {} slots, more than its 32-bit offsets "
+        // The tables hold places in a ring as 32-bit words.
+        if ((ring_slots + 1) * sizeof(double) > std::size_t(UINT32_MAX))
+            throw CapacityError(fmt::format("the fast variant's canonical sweep needs a ring of {} slots, more than its 32-bit places "
                                             "reach (a particle's partners are {} slots apart in storage)", ring_slots, reach));
         first_planned_ = false;
         in_team(parallel, [&] {
@@ -129,19 +130,20 @@ public:
     // Particle s's sum from `from`, its walls added, stored in p's f and t (Newton's law comes in the
     // next step's pass, vectorised, with the corrector: here, a grain at a time, its scalar divisions
     // would lengthen the force pass). The three components of a sum go as lanes of one quad (lane by
-    // lane, the scalar additions; x - y is x + (-y)), each read as the quad that starts at it in the slot:
-    // t_j, f and t_i are three consecutive values, and the fourth lane, the next value along, is not used.
+    // lane, the scalar additions; x - y is x + (-y)); add_as_j and add_as_i read them.
     void sum_particle(std::size_t s, const SlotSource& from, const NeighbourList& list, const WallContacts& walls, Particles& p) const
     {
-        const double* lo = reinterpret_cast<const double*>(from.lo);
-        const double* hi = reinterpret_cast<const double*>(from.hi);
         const std::size_t mask = from.mask, split = from.split;
-        auto at = [=](std::size_t k) { return (k < split ? lo : hi) + 9 * (k & mask); };  // slot k
+        auto add = [&](auto&& how, Index k) {
+            const SlotView& v = std::size_t(k) < split ? from.lo : from.hi;
+            const std::size_t at = std::size_t(k) & mask;
+            how(v.line[at].v, v.tz[at]);
+        };
         const Index* as_j = list.as_j.data();
         const Index* as_i = list.as_i.data();
         Quad f{}, tq{};
-        for (Index e = list.jstart[s]; e < list.jstart[s + 1]; ++e) add_as_j(at(std::size_t(as_j[e])), f, tq);
-        for (Index e = list.istart[s]; e < list.istart[s + 1]; ++e) add_as_i(at(std::size_t(as_i[e])), f, tq);
+        for (Index e = list.jstart[s]; e < list.jstart[s + 1]; ++e) add([&](const double* line, double) { add_as_j(line, f, tq); }, as_j[e]);
+        for (Index e = list.istart[s]; e < list.istart[s + 1]; ++e) add([&](const double* line, double tz) { add_as_i(line, tz, f, tq); }, as_i[e]);
         walls.add(s, f, tq);
         p.store_sum(s, f, tq);
     }
@@ -149,18 +151,18 @@ public:
     // The sums of a group of up to kGroup particles of one chunk's schedule, side by side: a chain of
     // additions per particle, all from the ring. One particle's sum alone (sum_particle) is a chain of
     // dependent additions ended by two loop exits whose trip counts no predictor learns; here the chains
-    // overlap and a group has two exits. The group's table (schedule()) holds the ring offsets in the
+    // overlap and a group has two exits. The group's table (schedule()) holds the ring places in the
     // canonical order, as j then as i, a row of kGroup a step; a particle's list that ends before the
     // group's longest goes on with the ring's slot of zeros, which adds nothing (the sum starts at +0 and
     // is never -0, and x + ±0 = x for every other x), so each particle's bits are those of sum_particle
     // (the same order, kept there for the sums that read two rings or the list of all slots, which the
-    // tables' ring offsets cannot name).
+    // tables' ring places cannot name).
     // Where vectors have eight lanes (AVX-512) a particle's force and torque are one vector, and each
-    // slot it reads one load of eight values (sum_group_eight); narrower (AVX2), such a vector is two
+    // slot it reads one load of its line (sum_group_eight); narrower (AVX2), such a vector is two
     // registers, and four sums with their inputs no longer fit the sixteen: GCC keeps them on the stack.
     // There the force and the torque are a quad each (sum_group_quads), which fit. The same additions
     // either way, lane by lane.
-    void sum_group(const Schedule& from, const Group& g, const Slot* ring, const WallContacts& walls, Particles& p) const
+    void sum_group(const Schedule& from, const Group& g, const SlotView& ring, const WallContacts& walls, Particles& p) const
     {
         if constexpr (kLanes >= 8)
             sum_group_eight(from, g, ring, walls, p);
@@ -170,58 +172,68 @@ public:
 
     // The two forms, public so that tests/test_canonical_sums.cpp runs both on any machine (a build
     // runs only the one its target's width picks).
-    // t_j and f as j (lanes: torque, then force, each added with the force's sign flipped, which is
-    // x - f bit for bit), f and t_i as i (force, then torque; the sum's lanes are swapped between the
-    // two). The last two lanes, the next values along, are not used.
-    void sum_group_eight(const Schedule& from, const Group& g, const Slot* ring, const WallContacts& walls, Particles& p) const
+    // As j, a slot's line is added whole, its force's sign flipped (x - f bit for bit): the lanes hold
+    // the torque (t_j), then the force, then two unused. As i, the torque's x and y move to the last
+    // two lanes, under t_i.x and t_i.y in the line, its z to a scalar, which adds t_i.z; the first
+    // three lanes are then unused. Unused lanes add values that are never read.
+    void sum_group_eight(const Schedule& from, const Group& g, const SlotView& ring, const WallContacts& walls, Particles& p) const
     {
         using Eight = Pack<double, 8>;
         using Bits = Pack<std::uint64_t, 8>;
         constexpr std::uint64_t kSign = std::uint64_t(1) << 63;
         constexpr Bits flip_force = {0, 0, 0, kSign, kSign, kSign, 0, 0};
-        const char* as_j = reinterpret_cast<const char*>(ring) + kTorqueJ * sizeof(double);
-        const char* as_i = reinterpret_cast<const char*>(ring) + kForce * sizeof(double);
+        const char* lines = reinterpret_cast<const char*>(ring.line);
+        const char* tz = reinterpret_cast<const char*>(ring.tz);
         // Through a reference, not a return value: a returned vector of 64 bytes has its own ABI
         // without AVX-512 (GCC's -Wpsabi), though the call is always inlined.
         auto load = [](Eight& v, const char* at) { std::memcpy(&v, at, sizeof(v)); };
         const std::uint32_t* row = from.table.data() + g.table;
         Eight sum[kGroup];
+        double z[kGroup];
         for (int l = 0; l < kGroup; ++l) sum[l] = Eight{};  // element by element, as in sum_group_quads
         for (std::int32_t e = 0; e < g.as_j; ++e, row += kGroup)
             for (int l = 0; l < kGroup; ++l) {
                 Eight v;
-                load(v, as_j + row[l]);
+                load(v, lines + 8 * std::size_t(row[l]));
                 sum[l] += Eight(Bits(v) ^ flip_force);
             }
-        for (int l = 0; l < kGroup; ++l) sum[l] = __builtin_shufflevector(sum[l], sum[l], 3, 4, 5, 0, 1, 2, 6, 7);
+        for (int l = 0; l < kGroup; ++l) {
+            z[l] = sum[l][2];
+            sum[l] = __builtin_shufflevector(sum[l], sum[l], 0, 1, 2, 3, 4, 5, 0, 1);
+        }
         for (std::int32_t e = 0; e < g.as_i; ++e, row += kGroup)
             for (int l = 0; l < kGroup; ++l) {
                 Eight v;
-                load(v, as_i + row[l]);
+                load(v, lines + 8 * std::size_t(row[l]));
                 sum[l] += v;
+                double w;
+                std::memcpy(&w, tz + row[l], sizeof(w));
+                z[l] += w;
             }
         for (int l = 0; l < g.count; ++l) {
             const std::size_t s = std::size_t(g.grain[l]);
-            Quad f = __builtin_shufflevector(sum[l], sum[l], 0, 1, 2, 6), tq = __builtin_shufflevector(sum[l], sum[l], 3, 4, 5, 7);
+            Quad f = __builtin_shufflevector(sum[l], sum[l], 3, 4, 5, 0), tq = {sum[l][6], sum[l][7], z[l], 0.0};
             walls.add(s, f, tq);
             p.store_sum(s, f, tq);
         }
     }
 
     // The force and the torque a quad each, slot by slot as sum_particle adds them.
-    void sum_group_quads(const Schedule& from, const Group& g, const Slot* ring, const WallContacts& walls, Particles& p) const
+    void sum_group_quads(const Schedule& from, const Group& g, const SlotView& ring, const WallContacts& walls, Particles& p) const
     {
-        const char* base = reinterpret_cast<const char*>(ring);
-        auto slot = [base](std::uint32_t offset) { return reinterpret_cast<const double*>(base + offset); };
+        const char* lines = reinterpret_cast<const char*>(ring.line);
+        const char* tz = reinterpret_cast<const char*>(ring.tz);
+        auto line = [lines](std::uint32_t at) { return reinterpret_cast<const double*>(lines + 8 * std::size_t(at)); };
+        auto z = [tz](std::uint32_t at) { return *reinterpret_cast<const double*>(tz + at); };
         const std::uint32_t* row = from.table.data() + g.table;
         // Zeroed element by element: `{}` on the arrays is a block clear, which GCC may emit as `rep stos`,
         // slow to start for a few vectors (it showed in perf); vector by vector it is a register clear.
         Quad f[kGroup], tq[kGroup];
         for (int l = 0; l < kGroup; ++l) f[l] = tq[l] = Quad{};
         for (std::int32_t e = 0; e < g.as_j; ++e, row += kGroup)
-            for (int l = 0; l < kGroup; ++l) add_as_j(slot(row[l]), f[l], tq[l]);
+            for (int l = 0; l < kGroup; ++l) add_as_j(line(row[l]), f[l], tq[l]);
         for (std::int32_t e = 0; e < g.as_i; ++e, row += kGroup)
-            for (int l = 0; l < kGroup; ++l) add_as_i(slot(row[l]), f[l], tq[l]);
+            for (int l = 0; l < kGroup; ++l) add_as_i(line(row[l]), z(row[l]), f[l], tq[l]);
         for (int l = 0; l < g.count; ++l) {
             const std::size_t s = std::size_t(g.grain[l]);
             walls.add(s, f[l], tq[l]);
@@ -235,30 +247,29 @@ public:
     }
 
 private:
-    // One slot (its nine values from `slot`) into a particle's force and torque as quads, read as the
-    // quads that start at each vector (the fourth lane, the next value along, is not used): as j, the
+    // One slot (its line, and t_i.z) into a particle's force and torque as quads, each read as the quad
+    // that starts at it in the line (the fourth lane, the next value along, is not used): as j, the
     // force subtracted and t_j added; as i, the force and t_i added.
-    [[gnu::always_inline]] static void add_as_j(const double* slot, Quad& f, Quad& tq)
+    [[gnu::always_inline]] static void add_as_j(const double* line, Quad& f, Quad& tq)
     {
         Quad q;
-        load_quad(q, slot + kForce);
+        load_quad(q, line + kForce);
         f -= q;
-        load_quad(q, slot + kTorqueJ);
+        load_quad(q, line + kTorqueJ);
         tq += q;
     }
-    [[gnu::always_inline]] static void add_as_i(const double* slot, Quad& f, Quad& tq)
+    [[gnu::always_inline]] static void add_as_i(const double* line, double tz, Quad& f, Quad& tq)
     {
         Quad q;
-        load_quad(q, slot + kForce);
+        load_quad(q, line + kForce);
         f += q;
-        load_quad(q, slot + kTorqueI);
-        tq += q;
+        tq += Quad{line[kTorqueI], line[kTorqueI + 1], tz, 0.0};
     }
 
     // The schedule of the particles by chunk[s]: each chunk's particles (order[start[c] … start[c + 1]),
     // sorted by their counts of slots as j, so that a group's lists are near one length), kGroup particles
-    // a group, and their tables: a row of ring offsets a step, the lists as j to the group's longest,
-    // then as i, padded with the offset of the ring's slot of zeros (ring_slots).
+    // a group, and their tables: a row of ring places a step, the lists as j to the group's longest,
+    // then as i, padded with the place of the ring's slot of zeros (ring_slots).
     void schedule(const NeighbourList& list, const std::vector<Index>& chunk, Schedule& out, std::vector<Index>& bucket) const
     {
         const std::size_t nch = chunks(chunk.size());
@@ -274,8 +285,8 @@ private:
         const Index* istart = list.istart.data();
         const Index* as_i = list.as_i.data();
         const std::size_t mask = ring_slots - 1;
-        auto offset = [mask](Index k) { return std::uint32_t((std::size_t(k) & mask) * sizeof(Slot)); };
-        const std::uint32_t zeros = std::uint32_t(ring_slots * sizeof(Slot));
+        auto place = [mask](Index k) { return std::uint32_t((std::size_t(k) & mask) * sizeof(double)); };
+        const std::uint32_t zeros = std::uint32_t(ring_slots * sizeof(double));
         group_start.assign(nch + 1, 0);
         groups.clear();
         for (std::size_t c = 0; c < nch; ++c) {
@@ -298,12 +309,12 @@ private:
                 for (Index e = 0; e < g.as_j; ++e)
                     for (int l = 0; l < kGroup; ++l) {
                         const Index s = g.grain[l];
-                        table.push_back(s >= 0 && e < jstart[s + 1] - jstart[s] ? offset(as_j[jstart[s] + e]) : zeros);
+                        table.push_back(s >= 0 && e < jstart[s + 1] - jstart[s] ? place(as_j[jstart[s] + e]) : zeros);
                     }
                 for (Index e = 0; e < g.as_i; ++e)
                     for (int l = 0; l < kGroup; ++l) {
                         const Index s = g.grain[l];
-                        table.push_back(s >= 0 && e < istart[s + 1] - istart[s] ? offset(as_i[istart[s] + e]) : zeros);
+                        table.push_back(s >= 0 && e < istart[s + 1] - istart[s] ? place(as_i[istart[s] + e]) : zeros);
                     }
                 groups.push_back(g);
             }
@@ -314,7 +325,6 @@ private:
     std::vector<Index> last_bucket_, first_bucket_;  // scratch: one chunk's particles while they are grouped
     bool first_planned_ = false;
 };
-static_assert(offsetof(Slot, tj) == CanonicalSums::kTorqueJ * sizeof(double) && offsetof(Slot, f) == CanonicalSums::kForce * sizeof(double) &&
-              offsetof(Slot, ti) == CanonicalSums::kTorqueI * sizeof(double));
+static_assert(sizeof(Slot) == 8 * sizeof(double) && CanonicalSums::kTorqueI + 2 == 8);
 
 } // namespace demmat::fast

@@ -64,23 +64,22 @@ public:
                 if (nt > 1) sums.plan_first(list);  // the downward threads' schedule
                 cut_pieces(list, pieces, chunks);
                 for (std::size_t q = 0; q < pieces; ++q) claims_[q].reset(piece_chunk_[q], piece_chunk_[q + 1]);
-                if (pieces > 1) all_.resize(list.pairs() + 1);  // + 1: a sum reads a quad from the last slot's t_j
+                if (pieces > 1 && all_.size() < list.pairs()) all_.assign(list.pairs());
             }
-            std::vector<Slot>& ring = rings_[t];
-            // + 2: the slot of zeros at ring_slots (the groups' padding), and the quad the sums read from
-            // the last value of a slot (its fourth lane, unused), past the end.
-            if (ring.size() < ring_slots + 2) ring.assign(ring_slots + 2, Slot{});
-            ring[ring_slots] = ring[ring_slots + 1] = Slot{};  // a larger ring from before may hold slots there
+            SlotStore& ring = rings_[t];
+            // + 1: the slot of zeros at ring_slots (the groups' padding).
+            if (ring.size() < ring_slots + 1) ring.assign(ring_slots + 1);
+            ring.zero(ring_slots);  // a larger ring from before may hold a slot there
             // The kernel's records and every list of wall candidates are ready (predict(), or a rebuild).
             std::int64_t my_pp = 0, my_pw = 0;  // this thread's contacts, added to pp and pw once
             if constexpr (M::walls) my_pw = walls.compute<M>(p, law);
 #pragma omp barrier
             const std::size_t c0 = piece_chunk_[pc], c1 = piece_chunk_[pc + 1];
-            const SlotSink in_ring{ring.data(), ring_slots - 1, nullptr};
+            const SlotSink in_ring{ring.view(), ring_slots - 1, {}};
             for (std::size_t ch; down ? claims_[pc].down(ch) : claims_[pc].up(ch);) {
                 // Slots near the end of a piece are also kept in all_, for the sums that straddle two pieces.
                 const bool edge = (pc > 0 && ch < c0 + span) || (pc + 1 < pieces && ch + span >= c1);
-                const SlotSink sink{in_ring.ring, in_ring.mask, edge ? all_.data() : nullptr};
+                const SlotSink sink{in_ring.ring, in_ring.mask, edge ? all_.view() : SlotView{}};
                 my_pp += kernel.template run<true>(std::size_t(pstart[ch * kChunk]), std::size_t(pstart[std::min(n, (ch + 1) * kChunk)]), nullptr, sink);
                 // The groups of this chunk's schedule; a group with a particle that straddles the end of
                 // the piece (three threads or more) goes a particle at a time, without that one.
@@ -115,7 +114,7 @@ public:
                 // thread met at its end.
                 const std::size_t m = claims_[pc].met();
                 const std::size_t up = down ? t - 1 : t, other = !down && t + 1 == nt ? t : up + 1;
-                const SlotSource split{rings_[up].data(), rings_[other].data(), ring_slots - 1, std::size_t(pstart[std::min(n, m * kChunk)])};
+                const SlotSource split{rings_[up].view(), rings_[other].view(), ring_slots - 1, std::size_t(pstart[std::min(n, m * kChunk)])};
                 const std::size_t e1 = std::min(c1, m + span + 1);
                 auto for_each_straddler = [&](auto&& f) {
                     for (std::size_t ch = m; ch < e1; ++ch)
@@ -134,7 +133,7 @@ public:
             }
             if (!down && pc > 0) {
                 // Those whose first slot is in the piece before (all_ holds all the slots they read).
-                const SlotSource everything{all_.data(), all_.data(), ~std::size_t(0), 0};
+                const SlotSource everything{all_.view(), all_.view(), ~std::size_t(0), 0};
                 const std::size_t b0 = piece_chunk_[pc - 1];
                 for (std::size_t ch = c0; ch < std::min(chunks, c0 + span + 1); ++ch)
                     for (Index e = last_start[ch]; e < last_start[ch + 1]; ++e) {
@@ -148,7 +147,7 @@ public:
         return {pp.load(), pw.load(), team};
     }
 
-    std::size_t bytes() const { return heap_bytes(piece_chunk_, rings_, all_) + nclaims_ * sizeof(Claim); }
+    std::size_t bytes() const { return heap_bytes(piece_chunk_, rings_) + all_.bytes() + nclaims_ * sizeof(Claim); }
 
 private:
     // piece_chunk_[q], q = 0 … pieces: where each piece of the sweep starts, in chunks, cut so that the
@@ -170,8 +169,8 @@ private:
     std::vector<std::size_t> piece_chunk_;
     std::unique_ptr<Claim[]> claims_;  // per piece
     std::size_t nclaims_ = 0;
-    std::vector<std::vector<Slot>> rings_;  // per thread
-    std::vector<Slot> all_;                 // every slot, where the sums that straddle two pieces read (several pieces)
+    std::vector<SlotStore> rings_;  // per thread
+    SlotStore all_;                 // every slot, where the sums that straddle two pieces read (several pieces)
 };
 
 } // namespace demmat::fast

@@ -5,13 +5,18 @@
 
 namespace demmat::fast {
 
-// Vectors, and vectors of vectors (their own and their elements' heap).
+// Vectors, and vectors of vectors or of parts with a bytes() of their own (their own and their
+// elements' heap).
 template <class C>
 std::size_t heap_bytes(const C& c)
 {
     if constexpr (requires { c.front().capacity(); }) {
         std::size_t b = c.capacity() * sizeof(c.front());
         for (const auto& inner : c) b += heap_bytes(inner);
+        return b;
+    } else if constexpr (requires { c.front().bytes(); }) {
+        std::size_t b = c.capacity() * sizeof(c.front());
+        for (const auto& inner : c) b += inner.bytes();
         return b;
     } else {
         return c.capacity() * sizeof(typename C::value_type);

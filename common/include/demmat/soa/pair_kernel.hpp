@@ -9,9 +9,11 @@
 #include <algorithm>
 #include <cstdint>
 #include <cstring>
+#include <vector>
 
 #include "demmat/contact_law.hpp"
 #include "demmat/contact_memory.hpp"
+#include "heap_bytes.hpp"
 #include "neighbour_list.hpp"
 #include "pair_stretches.hpp"
 #include "particles.hpp"
@@ -20,43 +22,73 @@
 
 namespace demmat::fast {
 
-// One contact's result, kept in list order: torque on j, force on i (on j it is -f), torque on i. In
-// this order a sum reads t_j and f (as j) or f and t_i (as i) as six consecutive values (sum_group).
-struct Slot {
-    Vec3d tj, f, ti;
+// One contact's result, kept in list order: torque on j, force on i (on j it is -f), torque on i. Eight
+// of its nine values fill one cache line, t_j, f, t_i.x, t_i.y, in this order, so that a sum reads t_j
+// and f (as j) or f and t_i's first two (as i) in one aligned load (a load across two lines costs two,
+// and nine values in a row put seven of eight slots across); t_i.z lies in an array beside (SlotView).
+struct alignas(64) Slot {
+    double v[8];
+    Vec3d tj() const { return {v[0], v[1], v[2]}; }
+    Vec3d f() const { return {v[3], v[4], v[5]}; }
 };
-static_assert(sizeof(Slot) == 9 * sizeof(double));
+static_assert(sizeof(Slot) == 64);
 
-// Where the canonical kernel puts slot k: ring[k & mask], a thread's ring of the slots its sweep has yet
-// to sum, and, where `all` is set, all[k] too (the whole list, for the sums that straddle two pieces).
+// Slots by index: slot k's line at line[k], its t_i.z at tz[k].
+struct SlotView {
+    Slot* line = nullptr;
+    double* tz = nullptr;
+};
+
+// Storage for count slots (a ring, or the whole list), zeroed.
+struct SlotStore {
+    std::vector<Slot> line;
+    std::vector<double> tz;
+
+    void assign(std::size_t count)
+    {
+        line.assign(count, Slot{});
+        tz.assign(count, 0.0);
+    }
+    void zero(std::size_t k)
+    {
+        line[k] = Slot{};
+        tz[k] = 0.0;
+    }
+    std::size_t size() const { return line.size(); }
+    Vec3d ti(std::size_t k) const { return {line[k].v[6], line[k].v[7], tz[k]}; }
+    // From slot k on.
+    SlotView view(std::size_t k = 0) { return {line.data() + k, tz.data() + k}; }
+    std::size_t bytes() const { return heap_bytes(line, tz); }
+};
+
+// Where the canonical kernel puts slot k: ring at k & mask, a thread's ring of the slots its sweep has
+// yet to sum, and, where all.line is set, all at k too (the whole list, for the sums that straddle two
+// pieces).
 struct SlotSink {
-    Slot* ring = nullptr;
+    SlotView ring;
     std::size_t mask = 0;
-    Slot* all = nullptr;
-    // count slots ks[e]'s nine values: the first eight as two quads, the ninth alone, straight from the
-    // kernel's rows into place. A whole pack (count = kLanes) is a loop of known length, which the
-    // compiler unrolls, and the test for `all` is made once per call, not once per slot.
+    SlotView all;
+    // count slots ks[e]'s nine values: the line as two quads, t_i.z alone, straight from the kernel's
+    // rows into place. A whole pack (count = kLanes) is a loop of known length, which the compiler
+    // unrolls, and the test for `all` is made once per call, not once per slot.
     template <class Head, class Tail, class Last>
     [[gnu::always_inline]] void put(const std::size_t* ks, int count, Head&& head, Tail&& tail, Last&& last) const
     {
-        auto to = [&](Slot* base, std::size_t m) {
-            auto one = [&](int e) { write(base + (ks[e] & m), head(e), tail(e), last(e)); };
+        auto to = [&](const SlotView& base, std::size_t m) {
+            auto one = [&](int e) {
+                const std::size_t k = ks[e] & m;
+                char* bytes = reinterpret_cast<char*>(base.line + k);
+                std::memcpy(bytes, &head(e), sizeof(Quad));
+                std::memcpy(bytes + sizeof(Quad), &tail(e), sizeof(Quad));
+                base.tz[k] = last(e);
+            };
             if (count == kLanes)
                 for (int e = 0; e < kLanes; ++e) one(e);
             else
                 for (int e = 0; e < count; ++e) one(e);
         };
         to(ring, mask);
-        if (all) to(all, ~std::size_t(0));
-    }
-
-private:
-    [[gnu::always_inline]] static void write(Slot* at, const Quad& head, const Quad& tail, double last)
-    {
-        char* bytes = reinterpret_cast<char*>(at);
-        std::memcpy(bytes, &head, sizeof(Quad));
-        std::memcpy(bytes + sizeof(Quad), &tail, sizeof(Quad));
-        at->ti.z = last;
+        if (all.line) to(all, ~std::size_t(0));
     }
 };
 
@@ -215,7 +247,7 @@ private:
         else
             for (int l = 0; l < count; ++l) found += int(touch[l] != 0);
         if constexpr (Canonical) {
-            // A slot is nine values: t_j, f, t_i; the first eight go as two quads, the ninth alone.
+            // A slot is nine values: t_j, f, t_i; the first eight (its line) go as two quads, the ninth alone.
             const Lanes g0[4] = {c.t_j.x, c.t_j.y, c.t_j.z, c.f_i.x}, g1[4] = {c.f_i.y, c.f_i.z, c.t_i.x, c.t_i.y};
             Quad r0[kLanes], r1[kLanes];
             lanes_to_rows<Lanes>(g0, r0);
