@@ -10,6 +10,7 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <utility>
 #include <vector>
 
 #include <fmt/format.h>
@@ -134,16 +135,19 @@ public:
     void sum_particle(std::size_t s, const SlotSource& from, const NeighbourList& list, const WallContacts& walls, Particles& p) const
     {
         const std::size_t mask = from.mask, split = from.split;
-        auto add = [&](auto&& how, Index k) {
+        auto at = [&](Index k) {  // slot k: its line and its t_i.z
             const SlotView& v = std::size_t(k) < split ? from.lo : from.hi;
-            const std::size_t at = std::size_t(k) & mask;
-            how(v.line[at].v, v.tz[at]);
+            const std::size_t i = std::size_t(k) & mask;
+            return std::pair<const double*, double>{v.line[i].v, v.tz[i]};
         };
         const Index* as_j = list.as_j.data();
         const Index* as_i = list.as_i.data();
         Quad f{}, tq{};
-        for (Index e = list.jstart[s]; e < list.jstart[s + 1]; ++e) add([&](const double* line, double) { add_as_j(line, f, tq); }, as_j[e]);
-        for (Index e = list.istart[s]; e < list.istart[s + 1]; ++e) add([&](const double* line, double tz) { add_as_i(line, tz, f, tq); }, as_i[e]);
+        for (Index e = list.jstart[s]; e < list.jstart[s + 1]; ++e) add_as_j(at(as_j[e]).first, f, tq);
+        for (Index e = list.istart[s]; e < list.istart[s + 1]; ++e) {
+            const auto [line, tz] = at(as_i[e]);
+            add_as_i(line, tz, f, tq);
+        }
         walls.add(s, f, tq);
         p.store_sum(s, f, tq);
     }
