@@ -7,7 +7,9 @@
 // the machine lets them (neither waits for the other). After each chunk, the upward thread sums the
 // particles whose last slot (as i or as j) was in it, the downward one those whose first was. The others
 // straddle the meeting point or the end of a piece; they are summed after the sweep. Which thread sums a
-// particle, and when, changes no bit of its sum.
+// particle, and when, changes no bit of its sum. A chunk's wall contacts are computed with its pairs, so
+// that the sums find their results in cache: every particle summed after chunk c has its own slot in c or
+// before it (upwards; from c on, downwards), and its walls were computed with that chunk.
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -57,8 +59,8 @@ public:
             // Two threads to a piece, one from each end; an odd thread count leaves the last piece one.
             const std::size_t pieces = (nt + 1) / 2, pc = t / 2;
             const bool down = t % 2 == 1;
-            // No barrier after the single: the walls and the rings below do not read what it sets, and the
-            // barrier after them waits for it (a barrier costs a system call, and the slower thread's wait).
+            // No barrier after the single: the rings below do not read what it sets, and the barrier after
+            // them waits for it (a barrier costs a system call, and the slower thread's wait).
 #pragma omp single nowait
             {
                 if (nt > 1) sums.plan_first(list);  // the downward threads' schedule
@@ -72,7 +74,6 @@ public:
             ring.zero(ring_slots);  // a larger ring from before may hold a slot there
             // The kernel's records and every list of wall candidates are ready (predict(), or a rebuild).
             std::int64_t my_pp = 0, my_pw = 0;  // this thread's contacts, added to pp and pw once
-            if constexpr (M::walls) my_pw = walls.compute<M>(p, law);
 #pragma omp barrier
             const std::size_t c0 = piece_chunk_[pc], c1 = piece_chunk_[pc + 1];
             const SlotSink in_ring{ring.view(), ring_slots - 1, {}};
@@ -81,6 +82,7 @@ public:
                 const bool edge = (pc > 0 && ch < c0 + span) || (pc + 1 < pieces && ch + span >= c1);
                 const SlotSink sink{in_ring.ring, in_ring.mask, edge ? all_.view() : SlotView{}};
                 my_pp += kernel.template run<true>(std::size_t(pstart[ch * kChunk]), std::size_t(pstart[std::min(n, (ch + 1) * kChunk)]), nullptr, sink);
+                if constexpr (M::walls) my_pw += walls.compute_range<M>(p, law, ch * kChunk, std::min(n, (ch + 1) * kChunk));
                 // The groups of this chunk's schedule; a group with a particle that straddles the end of
                 // the piece (three threads or more) goes a particle at a time, without that one.
                 const SlotSource from{in_ring.ring, in_ring.ring, in_ring.mask, 0};

@@ -3,7 +3,8 @@
 // (a scene has a handful of walls: testing each every step costs less than a wall list, and keeps the
 // moving wall out of the rebuild criterion), the particle–wall pairs are listed from the bits per
 // thread, in particle order, walls in wall order, and the force pass computes them a pack at a time on
-// the lanes, the packs shared out among all threads (a wall's grains may all be in one thread's range).
+// the lanes: fast_unordered shares the packs out among all threads (a wall's grains may all be in one
+// thread's range); the canonical sweep computes each chunk's with the chunk (canonical_sweep.hpp).
 #include <algorithm>
 #include <cstdint>
 #include <vector>
@@ -148,6 +149,29 @@ public:
             const std::size_t e = (k - first) * kLanes, count = std::min<std::size_t>(kLanes, l.cand[u].size() - e);
             Quad* st = q_ > 0 ? l.st[u].data() + e * q_ : nullptr;
             found += pack<M>(p, law, l.cand[u].data() + e, int(count), l.res[u].data() + e, st);
+        }
+        return found;
+    }
+
+    // The law on the candidates of particles [s0, s1) only, kLanes at a time, by the calling thread
+    // (a range's candidates lie together in each list, found by a binary search). Returns the contacts
+    // found.
+    template <class M>
+    [[gnu::always_inline]] std::int64_t compute_range(const Particles& p, const LawInputs& law, std::size_t s0, std::size_t s1)
+    {
+        Listing& l = *now_;
+        std::int64_t found = 0;
+        for (std::size_t u = 0, lo = 0; u < l.lists && lo < s1; lo = l.range_end[u++]) {
+            const std::size_t a = std::max(s0, lo), b = std::min(s1, l.range_end[u]);
+            if (a >= b) continue;
+            const std::vector<Candidate>& cand = l.cand[u];
+            auto below = [](const Candidate& c, std::size_t s) { return std::size_t(c.s) < s; };
+            const std::size_t e0 = std::size_t(std::lower_bound(cand.begin(), cand.end(), a, below) - cand.begin());
+            const std::size_t e1 = std::size_t(std::lower_bound(cand.begin() + std::ptrdiff_t(e0), cand.end(), b, below) - cand.begin());
+            for (std::size_t e = e0; e < e1; e += kLanes) {
+                Quad* st = q_ > 0 ? l.st[u].data() + e * q_ : nullptr;
+                found += pack<M>(p, law, cand.data() + e, int(std::min<std::size_t>(kLanes, e1 - e)), l.res[u].data() + e, st);
+            }
         }
         return found;
     }
