@@ -1,8 +1,9 @@
 // fast's canonical sums (canonical_sums.hpp): a group of particles summed side by side, in either of
-// its two forms (eight lanes a particle, for AVX-512; a quad each for force and torque, for narrower
-// targets), must give each particle the bits of its sum alone (sum_particle), the order of physics.md
-// §6. A build runs only the form its target's width picks, so the equivalence tests see one of them on
-// a given machine; this runs both here, on a list with random slot values of mixed magnitudes, where
+// its two forms from a schedule's table (eight lanes a particle, for AVX-512; a quad each for force and
+// torque, for narrower targets) or from the lists (sum_particles, the sums that straddle), must give
+// each particle the bits of its sum alone (sum_particles of one), the order of physics.md §6. A build
+// runs only the table form its target's width picks, so the equivalence tests see one of them on a
+// given machine; this runs both here, on a list with random slot values of mixed magnitudes, where
 // any change of order, sign or lane changes bits. The sum alone is checked in turn against the order
 // written out from every slot of the list, with ids that do not follow storage.
 #include <gtest/gtest.h>
@@ -66,7 +67,7 @@ std::vector<std::uint64_t> bits_of(const Particles& p, std::size_t s)
 
 } // namespace
 
-TEST(CanonicalSums, BothGroupFormsGiveEachParticleTheBitsOfItsSumAlone)
+TEST(CanonicalSums, EveryGroupFormGivesEachParticleTheBitsOfItsSumAlone)
 {
     std::mt19937_64 rng(12345);
     const std::size_t n = 3 * CanonicalSums::kChunk + 17;  // several chunks, the last one partial
@@ -91,14 +92,21 @@ TEST(CanonicalSums, BothGroupFormsGiveEachParticleTheBitsOfItsSumAlone)
 
     WallContacts walls;
     walls.init({}, 1e-5, n);
-    Particles alone, eight, quads;
-    for (Particles* p : {&alone, &eight, &quads}) {
+    Particles alone, eight, quads, side_by_side;
+    for (Particles* p : {&alone, &eight, &quads, &side_by_side}) {
         p->n = n;
         p->f.assign(3 * n, -1.0);
         p->t.assign(3 * n, -1.0);
     }
     const SlotSource from{ring.view(), ring.view(), mask, 0};
-    for (std::size_t s = 0; s < n; ++s) sums.sum_particle(s, from, list, walls, alone);
+    for (std::size_t s = 0; s < n; ++s) sums.sum_particles(&s, 1, from, list, walls, alone);
+    // Side by side in twos, threes and fours, each set out of storage order.
+    for (std::size_t s = 0, count = 2; s < n; s += count, count = count % 4 + 2) {
+        std::size_t set[CanonicalSums::kGroup];
+        const std::size_t c = std::min(count, n - s);
+        for (std::size_t l = 0; l < c; ++l) set[l] = s + c - 1 - l;
+        sums.sum_particles(set, int(c), from, list, walls, side_by_side);
+    }
     std::size_t grouped = 0;
     for (const CanonicalSums::Group& g : sums.by_last.groups) {
         sums.sum_group_eight(sums.by_last, g, ring.view(), walls, eight);
@@ -112,10 +120,11 @@ TEST(CanonicalSums, BothGroupFormsGiveEachParticleTheBitsOfItsSumAlone)
         with_slots += list.jstart[s + 1] > list.jstart[s] && list.istart[s + 1] > list.istart[s];
         EXPECT_EQ(bits_of(eight, s), bits_of(alone, s)) << "eight lanes, particle " << s;
         EXPECT_EQ(bits_of(quads, s), bits_of(alone, s)) << "quads, particle " << s;
+        EXPECT_EQ(bits_of(side_by_side, s), bits_of(alone, s)) << "sum_particles side by side, particle " << s;
     }
     EXPECT_GT(with_slots, n / 2);  // most sums read slots both as j and as i
 
-    // sum_particle against physics.md §6 written out: every slot of particle s, by the other particle's
+    // A sum alone against physics.md §6 written out: every slot of particle s, by the other particle's
     // id (as j below s's id, the force subtracted and t_j added; as i above, f and t_i added).
     std::vector<std::vector<std::pair<Index, std::size_t>>> mine(n);  // (other's id, slot)
     for (std::size_t k = 0; k < list.pairs(); ++k) {

@@ -128,12 +128,18 @@ public:
         first_planned_ = true;
     }
 
-    // Particle s's sum from `from`, its walls added, stored in p's f and t (Newton's law comes in the
-    // next step's pass, vectorised, with the corrector: here, a grain at a time, its scalar divisions
-    // would lengthen the force pass). The three components of a sum go as lanes of one quad (lane by
-    // lane, the scalar additions; x - y is x + (-y)); add_as_j and add_as_i read them.
-    void sum_particle(std::size_t s, const SlotSource& from, const NeighbourList& list, const WallContacts& walls, Particles& p) const
+    // The sums of up to kGroup particles (grain[0 … count)) from `from`, side by side, each with its
+    // walls added and stored in p's f and t (Newton's law comes in the next step's pass, vectorised, with
+    // the corrector: here, a grain at a time, its scalar divisions would lengthen the force pass). For
+    // the sums the groups' tables cannot name (those that read two rings, or the list of all slots): the
+    // slots are looked up from the particles' lists as they are read. As in sum_group, a chain of
+    // additions per particle, the chains side by side, and a list that ends early goes on with a slot of
+    // zeros, which adds nothing. The three components of a sum go as lanes of one quad (lane by lane,
+    // the scalar additions; x - y is x + (-y)); add_as_j and add_as_i read them.
+    void sum_particles(const std::size_t* grain, int count, const SlotSource& from, const NeighbourList& list, const WallContacts& walls,
+                       Particles& p) const
     {
+        static constexpr Slot kZeros{};
         const std::size_t mask = from.mask, split = from.split;
         auto at = [&](Index k) {  // slot k: its line and its t_i.z
             const SlotView& v = std::size_t(k) < split ? from.lo : from.hi;
@@ -142,25 +148,40 @@ public:
         };
         const Index* as_j = list.as_j.data();
         const Index* as_i = list.as_i.data();
-        Quad f{}, tq{};
-        for (Index e = list.jstart[s]; e < list.jstart[s + 1]; ++e) add_as_j(at(as_j[e]).first, f, tq);
-        for (Index e = list.istart[s]; e < list.istart[s + 1]; ++e) {
-            const auto [line, tz] = at(as_i[e]);
-            add_as_i(line, tz, f, tq);
+        Index j0[kGroup], jn[kGroup], i0[kGroup], in[kGroup], most_j = 0, most_i = 0;  // each list's start and length
+        Quad f[kGroup], tq[kGroup];
+        for (int l = 0; l < kGroup; ++l) {
+            const std::size_t s = grain[l < count ? l : 0];
+            j0[l] = list.jstart[s];
+            i0[l] = list.istart[s];
+            jn[l] = l < count ? list.jstart[s + 1] - j0[l] : 0;
+            in[l] = l < count ? list.istart[s + 1] - i0[l] : 0;
+            most_j = std::max(most_j, jn[l]);
+            most_i = std::max(most_i, in[l]);
+            f[l] = tq[l] = Quad{};
         }
-        walls.add(s, f, tq);
-        p.store_sum(s, f, tq);
+        for (Index e = 0; e < most_j; ++e)
+            for (int l = 0; l < kGroup; ++l) add_as_j(e < jn[l] ? at(as_j[j0[l] + e]).first : kZeros.v, f[l], tq[l]);
+        for (Index e = 0; e < most_i; ++e)
+            for (int l = 0; l < kGroup; ++l) {
+                const auto [line, tz] = e < in[l] ? at(as_i[i0[l] + e]) : std::pair<const double*, double>{kZeros.v, 0.0};
+                add_as_i(line, tz, f[l], tq[l]);
+            }
+        for (int l = 0; l < count; ++l) {
+            walls.add(grain[l], f[l], tq[l]);
+            p.store_sum(grain[l], f[l], tq[l]);
+        }
     }
 
     // The sums of a group of up to kGroup particles of one chunk's schedule, side by side: a chain of
-    // additions per particle, all from the ring. One particle's sum alone (sum_particle) is a chain of
+    // additions per particle, all from the ring. One particle's sum alone is a chain of
     // dependent additions ended by two loop exits whose trip counts no predictor learns; here the chains
     // overlap and a group has two exits. The group's table (schedule()) holds the ring places in the
     // canonical order, as j then as i, a row of kGroup a step; a particle's list that ends before the
     // group's longest goes on with the ring's slot of zeros, which adds nothing (the sum starts at +0 and
-    // is never -0, and x + ±0 = x for every other x), so each particle's bits are those of sum_particle
-    // (the same order, kept there for the sums that read two rings or the list of all slots, which the
-    // tables' ring places cannot name).
+    // is never -0, and x + ±0 = x for every other x), so each particle's bits are those of its sum alone
+    // (sum_particles, which looks its slots up in the lists, for the sums that read two rings or the
+    // list of all slots, which the tables' ring places cannot name).
     // Where vectors have eight lanes (AVX-512) a particle's force and torque are one vector, and each
     // slot it reads one load of its line (sum_group_eight); narrower (AVX2), such a vector is two
     // registers, and four sums with their inputs no longer fit the sixteen: GCC keeps them on the stack.
@@ -222,7 +243,7 @@ public:
         }
     }
 
-    // The force and the torque a quad each, slot by slot as sum_particle adds them.
+    // The force and the torque a quad each, slot by slot as sum_particles adds them.
     void sum_group_quads(const Schedule& from, const Group& g, const SlotView& ring, const WallContacts& walls, Particles& p) const
     {
         const char* lines = reinterpret_cast<const char*>(ring.line);

@@ -101,8 +101,11 @@ public:
                         sums.sum_group(schedule, g, in_ring.ring, walls, p);
                         continue;
                     }
+                    std::size_t mine[CanonicalSums::kGroup];
+                    int count = 0;
                     for (int l = 0; l < g.count; ++l)
-                        if (inside(g.grain[l])) sums.sum_particle(std::size_t(g.grain[l]), from, list, walls, p);
+                        if (inside(g.grain[l])) mine[count++] = std::size_t(g.grain[l]);
+                    if (count > 0) sums.sum_particles(mine, count, from, list, walls, p);
                 }
             }
 #pragma omp barrier
@@ -112,8 +115,8 @@ public:
                 // the downward one's (each holds the last ring_slots it wrote, and no sum reaches over
                 // more). The piece's two threads take half of them each, counted (most lie just above m,
                 // so a cut by chunk would leave nearly all to one thread), in runs (not every other one:
-                // neighbours in storage share the cache lines of the sums they store). A piece of one
-                // thread met at its end.
+                // neighbours in storage share the cache lines of the sums they store), kGroup side by
+                // side. A piece of one thread met at its end.
                 const std::size_t m = claims_[pc].met();
                 const std::size_t up = down ? t - 1 : t, other = !down && t + 1 == nt ? t : up + 1;
                 const SlotSource split{rings_[up].view(), rings_[other].view(), ring_slots - 1, std::size_t(pstart[std::min(n, m * kChunk)])};
@@ -128,8 +131,9 @@ public:
                 std::size_t count = 0, at = 0;
                 for_each_straddler([&](std::size_t) { ++count; });
                 const std::size_t from = down ? count / 2 : 0, to = down ? count : count / 2;
+                Batch batch(sums, split, list, walls, p);
                 for_each_straddler([&](std::size_t s) {
-                    if (at >= from && at < to) sums.sum_particle(s, split, list, walls, p);
+                    if (at >= from && at < to) batch.add(s);
                     ++at;
                 });
             }
@@ -137,10 +141,11 @@ public:
                 // Those whose first slot is in the piece before (all_ holds all the slots they read).
                 const SlotSource everything{all_.view(), all_.view(), ~std::size_t(0), 0};
                 const std::size_t b0 = piece_chunk_[pc - 1];
+                Batch batch(sums, everything, list, walls, p);
                 for (std::size_t ch = c0; ch < std::min(chunks, c0 + span + 1); ++ch)
                     for (Index e = last_start[ch]; e < last_start[ch + 1]; ++e) {
                         const std::size_t s = std::size_t(by_last[e]), f = std::size_t(first_chunk[s]);
-                        if (f >= b0 && f < c0) sums.sum_particle(s, everything, list, walls, p);
+                        if (f >= b0 && f < c0) batch.add(s);
                     }
             }
             pp += my_pp;
@@ -152,6 +157,38 @@ public:
     std::size_t bytes() const { return heap_bytes(piece_chunk_, rings_) + all_.bytes() + nclaims_ * sizeof(Claim); }
 
 private:
+    // The sums that straddle a meeting point or two pieces, as they are found, kGroup side by side
+    // (sum_particles); the last few when it goes.
+    class Batch {
+    public:
+        Batch(const CanonicalSums& sums, const SlotSource& from, const NeighbourList& list, const WallContacts& walls, Particles& p)
+            : sums_(sums), from_(from), list_(list), walls_(walls), p_(p)
+        {
+        }
+        Batch(const Batch&) = delete;
+        Batch& operator=(const Batch&) = delete;
+        ~Batch() { flush(); }
+        void add(std::size_t s)
+        {
+            grain_[count_++] = s;
+            if (count_ == CanonicalSums::kGroup) flush();
+        }
+
+    private:
+        void flush()
+        {
+            if (count_ > 0) sums_.sum_particles(grain_, count_, from_, list_, walls_, p_);
+            count_ = 0;
+        }
+        const CanonicalSums& sums_;
+        const SlotSource& from_;
+        const NeighbourList& list_;
+        const WallContacts& walls_;
+        Particles& p_;
+        std::size_t grain_[CanonicalSums::kGroup];
+        int count_ = 0;
+    };
+
     // piece_chunk_[q], q = 0 … pieces: where each piece of the sweep starts, in chunks, cut so that the
     // pieces hold about as many slots each.
     void cut_pieces(const NeighbourList& list, std::size_t pieces, std::size_t chunks)
