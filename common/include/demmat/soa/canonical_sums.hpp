@@ -6,6 +6,7 @@
 // this plans, for the sweep, which chunk's slots each sum waits for, and cuts each chunk's schedule into
 // groups of kGroup particles summed side by side.
 #include <algorithm>
+#include <atomic>
 #include <bit>
 #include <cstddef>
 #include <cstdint>
@@ -86,24 +87,36 @@ public:
         const Index* pstart = list.start.data();
         first_chunk.resize(n);
         last_chunk.resize(n);
-        span_chunks = 0;
-        std::size_t reach = 0;  // the most slots from the start of a particle's first chunk to the end of its last
-        for (std::size_t s = 0; s < n; ++s) {
-            std::size_t first = s, last = s;
-            auto stored_at = [&](Index k) {  // the particle slot k is stored with
-                const std::size_t at = std::size_t(std::min(owner[k], partner[k]));
-                first = std::min(first, at);
-                last = std::max(last, at);
-            };
-            for (Index e = jstart[s]; e < jstart[s + 1]; ++e) stored_at(as_j[e]);
-            for (Index e = istart[s]; e < istart[s + 1]; ++e) stored_at(as_i[e]);
-            first /= kChunk;
-            last /= kChunk;
-            first_chunk[s] = Index(first);
-            last_chunk[s] = Index(last);
-            span_chunks = std::max(span_chunks, last - first);
-            reach = std::max(reach, std::size_t(pstart[std::min(n, (last + 1) * kChunk)] - pstart[first * kChunk]));
-        }
+        // The most chunks, and slots, from the start of a particle's first chunk to the end of its last.
+        std::atomic<std::size_t> most_chunks{0}, most_slots{0};
+        auto raise = [](std::atomic<std::size_t>& to, std::size_t v) {
+            for (std::size_t cur = to.load(std::memory_order_relaxed); v > cur && !to.compare_exchange_weak(cur, v, std::memory_order_relaxed);) {
+            }
+        };
+        in_team(parallel, [&] {
+            std::size_t chunks_here = 0, slots_here = 0;
+#pragma omp for schedule(static) nowait
+            for (std::size_t s = 0; s < n; ++s) {
+                std::size_t first = s, last = s;
+                auto stored_at = [&](Index k) {  // the particle slot k is stored with
+                    const std::size_t at = std::size_t(std::min(owner[k], partner[k]));
+                    first = std::min(first, at);
+                    last = std::max(last, at);
+                };
+                for (Index e = jstart[s]; e < jstart[s + 1]; ++e) stored_at(as_j[e]);
+                for (Index e = istart[s]; e < istart[s + 1]; ++e) stored_at(as_i[e]);
+                first /= kChunk;
+                last /= kChunk;
+                first_chunk[s] = Index(first);
+                last_chunk[s] = Index(last);
+                chunks_here = std::max(chunks_here, last - first);
+                slots_here = std::max(slots_here, std::size_t(pstart[std::min(n, (last + 1) * kChunk)] - pstart[first * kChunk]));
+            }
+            raise(most_chunks, chunks_here);
+            raise(most_slots, slots_here);
+        });
+        span_chunks = most_chunks.load();
+        const std::size_t reach = most_slots.load();
         ring_slots = std::bit_ceil(std::max<std::size_t>(reach, 1));
         // The tables hold places in a ring as 32-bit words.
         if ((ring_slots + 1) * sizeof(double) > std::size_t(UINT32_MAX))
@@ -295,7 +308,7 @@ private:
     // sorted by their counts of slots as j, so that a group's lists are near one length), kGroup particles
     // a group, and their tables: a row of ring places a step, the lists as j to the group's longest,
     // then as i, padded with the place of the ring's slot of zeros (ring_slots).
-    void schedule(const NeighbourList& list, const std::vector<Index>& chunk, Schedule& out, std::vector<Index>& bucket) const
+    void schedule(const NeighbourList& list, const std::vector<Index>& chunk, Schedule& out, std::vector<std::uint64_t>& bucket) const
     {
         const std::size_t nch = chunks(chunk.size());
         bucket_sort(chunk, nch, out.start, out.order);
@@ -315,39 +328,41 @@ private:
         group_start.assign(nch + 1, 0);
         groups.clear();
         for (std::size_t c = 0; c < nch; ++c) {
-            bucket.assign(order.begin() + start[c], order.begin() + start[c + 1]);
-            std::sort(bucket.begin(), bucket.end(), [&](Index a, Index b) {
-                const Index la = jstart[a + 1] - jstart[a], lb = jstart[b + 1] - jstart[b];
-                return la != lb ? la < lb : a < b;
-            });
+            // The chunk's particles by (count as j, storage index), sorted as one integer each.
+            bucket.clear();
+            for (Index e = start[c]; e < start[c + 1]; ++e) {
+                const Index s = order[std::size_t(e)];
+                bucket.push_back(std::uint64_t(jstart[s + 1] - jstart[s]) << 32 | std::uint64_t(s));
+            }
+            std::sort(bucket.begin(), bucket.end());
             for (std::size_t g0 = 0; g0 < bucket.size(); g0 += kGroup) {
                 Group g;
                 g.count = std::int32_t(std::min<std::size_t>(kGroup, bucket.size() - g0));
                 g.table = std::uint32_t(table.size());
                 for (int l = 0; l < kGroup; ++l) {
-                    const Index s = l < g.count ? bucket[g0 + std::size_t(l)] : -1;
+                    const Index s = l < g.count ? Index(bucket[g0 + std::size_t(l)] & 0xffffffffu) : -1;
                     g.grain[l] = s;
                     if (s < 0) continue;
                     g.as_j = std::max(g.as_j, jstart[s + 1] - jstart[s]);
                     g.as_i = std::max(g.as_i, istart[s + 1] - istart[s]);
                 }
-                for (Index e = 0; e < g.as_j; ++e)
-                    for (int l = 0; l < kGroup; ++l) {
-                        const Index s = g.grain[l];
-                        table.push_back(s >= 0 && e < jstart[s + 1] - jstart[s] ? place(as_j[jstart[s] + e]) : zeros);
-                    }
-                for (Index e = 0; e < g.as_i; ++e)
-                    for (int l = 0; l < kGroup; ++l) {
-                        const Index s = g.grain[l];
-                        table.push_back(s >= 0 && e < istart[s + 1] - istart[s] ? place(as_i[istart[s] + e]) : zeros);
-                    }
+                // The group's rows, the slot of zeros wherever a list has ended, then each list down its column.
+                table.resize(table.size() + std::size_t(g.as_j + g.as_i) * kGroup, zeros);
+                std::uint32_t* rows = table.data() + g.table;
+                for (int l = 0; l < g.count; ++l) {
+                    const Index s = g.grain[l];
+                    for (Index e = 0; e < jstart[s + 1] - jstart[s]; ++e)
+                        rows[std::size_t(e) * kGroup + std::size_t(l)] = place(as_j[jstart[s] + e]);
+                    for (Index e = 0; e < istart[s + 1] - istart[s]; ++e)
+                        rows[std::size_t(g.as_j + e) * kGroup + std::size_t(l)] = place(as_i[istart[s] + e]);
+                }
                 groups.push_back(g);
             }
             group_start[c + 1] = Index(groups.size());
         }
     }
 
-    std::vector<Index> last_bucket_, first_bucket_;  // scratch: one chunk's particles while they are grouped
+    std::vector<std::uint64_t> last_bucket_, first_bucket_;  // scratch: one chunk's particles while they are grouped
     bool first_planned_ = false;
 };
 static_assert(sizeof(Slot) == 8 * sizeof(double) && CanonicalSums::kTorqueI + 2 == 8);

@@ -100,26 +100,43 @@ public:
     }
 
     // as_i and as_j from owner and partner: each particle's slots as i, by ascending partner id, and as
-    // j, by ascending owner id (ids are unique, so the order is total).
+    // j, by ascending owner id (ids are unique, so the order is total). The two sides are independent: on
+    // a team, one thread each (the bucket sort is serial, and the two take about as long).
     void index_by_particle(const std::vector<Index>& id, bool parallel)
     {
         const std::size_t n = start.size() - 1;
-        bucket_sort(owner, n, istart, as_i);
-        bucket_sort(partner, n, jstart, as_j);
-        const Index* powner = owner.data();
-        const Index* ppartner = partner.data();
         in_team(parallel, [&] {
-#pragma omp for schedule(static)
-            for (std::size_t s = 0; s < n; ++s) {
-                std::sort(as_i.begin() + istart[s], as_i.begin() + istart[s + 1], [&](Index x, Index y) { return id[ppartner[x]] < id[ppartner[y]]; });
-                std::sort(as_j.begin() + jstart[s], as_j.begin() + jstart[s + 1], [&](Index x, Index y) { return id[powner[x]] < id[powner[y]]; });
-            }
+#pragma omp single nowait
+            by_particle(owner, partner, id, n, istart, as_i);
+#pragma omp single nowait
+            by_particle(partner, owner, id, n, jstart, as_j);
         });
     }
 
     std::size_t bytes() const { return heap_bytes(start, partner, owner, istart, as_i, jstart, as_j, spans, scan_); }
 
 private:
+    // The slots by `key` (bucket_sort), each particle's by the id of `other`: a handful a particle, so an
+    // insertion sort, each key looked up once.
+    static void by_particle(const std::vector<Index>& key, const std::vector<Index>& other, const std::vector<Index>& id, std::size_t n,
+                            std::vector<Index>& first, std::vector<Index>& order)
+    {
+        bucket_sort(key, n, first, order);
+        const Index* po = other.data();
+        const Index* pid = id.data();
+        Index* slots = order.data();
+        for (std::size_t s = 0; s < n; ++s) {
+            Index* const begin = slots + first[s];
+            Index* const end = slots + first[s + 1];
+            for (Index* a = begin + 1; a < end; ++a) {
+                const Index k = *a, at = pid[po[k]];
+                Index* b = a;
+                for (; b > begin && pid[po[b[-1]]] > at; --b) *b = b[-1];
+                *b = k;
+            }
+        }
+    }
+
     std::vector<std::vector<Index>> scan_;  // per thread: partners found by the scan
 };
 
