@@ -7,6 +7,7 @@
 // any change of order, sign or lane changes bits. The sum alone is checked in turn against the order
 // written out from every slot of the list, with ids that do not follow storage.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <cmath>
@@ -66,6 +67,63 @@ std::vector<std::uint64_t> bits_of(const Particles& p, std::size_t s)
 }
 
 } // namespace
+
+// The list's canonical indexes (as_i, as_j, earliest), built by counting sorts, and the plan's chunk
+// range per particle, against the rules written out slot by slot; the same bits from a team of three
+// as from one thread.
+TEST(CanonicalSums, IndexesAndPlanFollowTheRulesWrittenOut)
+{
+    std::mt19937_64 rng(777);
+    const std::size_t n = 5 * CanonicalSums::kChunk + 3;
+    std::vector<Index> id;
+    const NeighbourList list = random_list(n, 300, rng, id);
+    std::vector<std::vector<std::pair<Index, Index>>> as_i(n), as_j(n);  // (other's id, slot)
+    std::vector<Index> earliest(n);
+    for (std::size_t s = 0; s < n; ++s) earliest[s] = Index(s);
+    for (std::size_t k = 0; k < list.pairs(); ++k) {
+        const Index i = list.owner[k], j = list.partner[k], at = std::min(i, j);
+        as_i[std::size_t(i)].push_back({id[std::size_t(j)], Index(k)});
+        as_j[std::size_t(j)].push_back({id[std::size_t(i)], Index(k)});
+        for (Index q : {i, j}) earliest[std::size_t(q)] = std::min(earliest[std::size_t(q)], at);
+    }
+    std::size_t far = 0;  // particles whose earliest slot lies in an earlier chunk
+    for (std::size_t s = 0; s < n; ++s) {
+        std::sort(as_i[s].begin(), as_i[s].end());
+        std::sort(as_j[s].begin(), as_j[s].end());
+        auto slots_of = [](const std::vector<Index>& start, const std::vector<Index>& slots, std::size_t s) {
+            return std::vector<Index>(slots.begin() + start[s], slots.begin() + start[s + 1]);
+        };
+        std::vector<Index> want_i, want_j;
+        for (const auto& e : as_i[s]) want_i.push_back(e.second);
+        for (const auto& e : as_j[s]) want_j.push_back(e.second);
+        EXPECT_EQ(slots_of(list.istart, list.as_i, s), want_i) << "as_i of particle " << s;
+        EXPECT_EQ(slots_of(list.jstart, list.as_j, s), want_j) << "as_j of particle " << s;
+        EXPECT_EQ(list.earliest[s], earliest[s]) << "earliest of particle " << s;
+        far += std::size_t(earliest[s]) / CanonicalSums::kChunk < s / CanonicalSums::kChunk;
+    }
+    EXPECT_GT(far, n / 20);
+
+    CanonicalSums sums;
+    sums.plan(list, n, false);
+    for (std::size_t s = 0; s < n; ++s) {
+        EXPECT_EQ(sums.first_chunk[s], Index(std::size_t(earliest[s]) / CanonicalSums::kChunk)) << "particle " << s;
+        EXPECT_EQ(sums.last_chunk[s], Index(s / CanonicalSums::kChunk)) << "particle " << s;
+    }
+
+    const int saved = omp_get_max_threads();
+    omp_set_num_threads(3);
+    NeighbourList team = list;
+    team.as_i.assign(team.as_i.size(), -1);
+    team.as_j.assign(team.as_j.size(), -1);
+    team.earliest.assign(n, -1);
+    team.index_by_particle(id, true);
+    omp_set_num_threads(saved);
+    EXPECT_EQ(team.istart, list.istart);
+    EXPECT_EQ(team.as_i, list.as_i);
+    EXPECT_EQ(team.jstart, list.jstart);
+    EXPECT_EQ(team.as_j, list.as_j);
+    EXPECT_EQ(team.earliest, list.earliest);
+}
 
 TEST(CanonicalSums, EveryGroupFormGivesEachParticleTheBitsOfItsSumAlone)
 {

@@ -72,18 +72,13 @@ public:
     static std::size_t chunks(std::size_t n) { return (n + kChunk - 1) / kChunk; }
 
     // After a canonical list is built: a particle's sum needs the slots of the chunks from the first
-    // where one of its slots is stored to the last (its own, or its partners' below it in storage: a
-    // slot is stored with the pair's particle that comes first). The two schedules are planned side by
-    // side on a team of two or more (the list is rebuilt in the timed loop); a team of one plans only
-    // the upward one, all that a sweep of one thread reads.
+    // where one of its slots is stored (the list's earliest) to its own (a slot is stored with the pair's
+    // particle that comes first, so none of a particle's slots lies above it). The two schedules are
+    // planned side by side on a team of two or more (the list is rebuilt in the timed loop); a team of
+    // one plans only the upward one, all that a sweep of one thread reads.
     void plan(const NeighbourList& list, std::size_t n, bool parallel)
     {
-        const Index* owner = list.owner.data();
-        const Index* partner = list.partner.data();
-        const Index* istart = list.istart.data();
-        const Index* as_i = list.as_i.data();
-        const Index* jstart = list.jstart.data();
-        const Index* as_j = list.as_j.data();
+        const Index* earliest = list.earliest.data();
         const Index* pstart = list.start.data();
         first_chunk.resize(n);
         last_chunk.resize(n);
@@ -97,16 +92,7 @@ public:
             std::size_t chunks_here = 0, slots_here = 0;
 #pragma omp for schedule(static) nowait
             for (std::size_t s = 0; s < n; ++s) {
-                std::size_t first = s, last = s;
-                auto stored_at = [&](Index k) {  // the particle slot k is stored with
-                    const std::size_t at = std::size_t(std::min(owner[k], partner[k]));
-                    first = std::min(first, at);
-                    last = std::max(last, at);
-                };
-                for (Index e = jstart[s]; e < jstart[s + 1]; ++e) stored_at(as_j[e]);
-                for (Index e = istart[s]; e < istart[s + 1]; ++e) stored_at(as_i[e]);
-                first /= kChunk;
-                last /= kChunk;
+                const std::size_t first = std::size_t(earliest[s]) / kChunk, last = s / kChunk;
                 first_chunk[s] = Index(first);
                 last_chunk[s] = Index(last);
                 chunks_here = std::max(chunks_here, last - first);
@@ -125,7 +111,7 @@ public:
         first_planned_ = false;
         in_team(parallel, [&] {
 #pragma omp single nowait
-            schedule(list, last_chunk, by_last, last_bucket_);
+            schedule(list, last_chunk, by_last, last_scratch_);
             if (thread_count() > 1) {
 #pragma omp single nowait
                 plan_first(list);
@@ -137,7 +123,7 @@ public:
     void plan_first(const NeighbourList& list)
     {
         if (first_planned_) return;
-        schedule(list, first_chunk, by_first, first_bucket_);
+        schedule(list, first_chunk, by_first, first_scratch_);
         first_planned_ = true;
     }
 
@@ -281,10 +267,17 @@ public:
 
     std::size_t bytes() const
     {
-        return heap_bytes(first_chunk, last_chunk, last_bucket_, first_bucket_) + by_last.bytes() + by_first.bytes();
+        return heap_bytes(first_chunk, last_chunk) + last_scratch_.bytes() + first_scratch_.bytes() + by_last.bytes() + by_first.bytes();
     }
 
 private:
+    // One chunk's particles while they are grouped, and the counting sort's places (one per schedule:
+    // the two are planned side by side).
+    struct Scratch {
+        std::vector<Index> grain, at;
+        std::size_t bytes() const { return heap_bytes(grain, at); }
+    };
+
     // One slot (its line, and t_i.z) into a particle's force and torque as quads, each read as the quad
     // that starts at it in the line (the fourth lane, the next value along, is not used): as j, the
     // force subtracted and t_j added; as i, the force and t_i added.
@@ -308,7 +301,7 @@ private:
     // sorted by their counts of slots as j, so that a group's lists are near one length), kGroup particles
     // a group, and their tables: a row of ring places a step, the lists as j to the group's longest,
     // then as i, padded with the place of the ring's slot of zeros (ring_slots).
-    void schedule(const NeighbourList& list, const std::vector<Index>& chunk, Schedule& out, std::vector<std::uint64_t>& bucket) const
+    void schedule(const NeighbourList& list, const std::vector<Index>& chunk, Schedule& out, Scratch& scratch) const
     {
         const std::size_t nch = chunks(chunk.size());
         bucket_sort(chunk, nch, out.start, out.order);
@@ -328,19 +321,24 @@ private:
         group_start.assign(nch + 1, 0);
         groups.clear();
         for (std::size_t c = 0; c < nch; ++c) {
-            // The chunk's particles by (count as j, storage index), sorted as one integer each.
-            bucket.clear();
-            for (Index e = start[c]; e < start[c + 1]; ++e) {
-                const Index s = order[std::size_t(e)];
-                bucket.push_back(std::uint64_t(jstart[s + 1] - jstart[s]) << 32 | std::uint64_t(s));
-            }
-            std::sort(bucket.begin(), bucket.end());
-            for (std::size_t g0 = 0; g0 < bucket.size(); g0 += kGroup) {
+            // The chunk's particles by (count as j, storage index): a stable counting sort by count of
+            // the chunk's particles, which order holds by storage index.
+            const Index* const in = order.data() + start[c];
+            const std::size_t size = std::size_t(start[c + 1] - start[c]);
+            auto count_of = [&](Index s) { return std::size_t(jstart[s + 1] - jstart[s]); };
+            std::size_t most = 0;
+            for (std::size_t e = 0; e < size; ++e) most = std::max(most, count_of(in[e]));
+            scratch.at.assign(most + 2, 0);
+            for (std::size_t e = 0; e < size; ++e) ++scratch.at[count_of(in[e]) + 1];
+            for (std::size_t k = 0; k <= most; ++k) scratch.at[k + 1] += scratch.at[k];
+            scratch.grain.resize(size);
+            for (std::size_t e = 0; e < size; ++e) scratch.grain[std::size_t(scratch.at[count_of(in[e])]++)] = in[e];
+            for (std::size_t g0 = 0; g0 < size; g0 += kGroup) {
                 Group g;
-                g.count = std::int32_t(std::min<std::size_t>(kGroup, bucket.size() - g0));
+                g.count = std::int32_t(std::min<std::size_t>(kGroup, size - g0));
                 g.table = std::uint32_t(table.size());
                 for (int l = 0; l < kGroup; ++l) {
-                    const Index s = l < g.count ? Index(bucket[g0 + std::size_t(l)] & 0xffffffffu) : -1;
+                    const Index s = l < g.count ? scratch.grain[g0 + std::size_t(l)] : -1;
                     g.grain[l] = s;
                     if (s < 0) continue;
                     g.as_j = std::max(g.as_j, jstart[s + 1] - jstart[s]);
@@ -362,7 +360,7 @@ private:
         }
     }
 
-    std::vector<std::uint64_t> last_bucket_, first_bucket_;  // scratch: one chunk's particles while they are grouped
+    Scratch last_scratch_, first_scratch_;
     bool first_planned_ = false;
 };
 static_assert(sizeof(Slot) == 8 * sizeof(double) && CanonicalSums::kTorqueI + 2 == 8);

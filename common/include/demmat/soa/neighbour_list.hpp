@@ -8,6 +8,7 @@
 // back only to its partners below it in storage, never above, as it did with the slots under the lower id.
 #include <algorithm>
 #include <cstddef>
+#include <cstdint>
 #include <utility>
 #include <vector>
 
@@ -38,6 +39,9 @@ public:
     std::vector<Index> start, partner, owner;  // the slots stored at each particle; each slot's j and i (by id)
     std::vector<Index> istart, as_i;           // canonical: the slots where each particle is i, partners ascending
     std::vector<Index> jstart, as_j;           // canonical: the slots where each particle is j, owners ascending
+    // canonical: per particle, the earliest storage index where one of its slots is stored (its own, or
+    // that of a partner below it in storage: a slot is stored with the pair's storage-earlier particle).
+    std::vector<Index> earliest;
     // Per thread of the last build: the storage range its slots reach (its particles and their partners).
     std::vector<std::pair<std::size_t, std::size_t>> spans;
 
@@ -100,44 +104,87 @@ public:
     }
 
     // as_i and as_j from owner and partner: each particle's slots as i, by ascending partner id, and as
-    // j, by ascending owner id (ids are unique, so the order is total). The two sides are independent: on
-    // a team, one thread each (the bucket sort is serial, and the two take about as long).
+    // j, by ascending owner id (ids are unique, so the order is total); and earliest. Two counting sorts
+    // a side and no comparison: the slots grouped by owner and by partner, then each side dealt from the
+    // other's grouping (deal()). On a team, each of the four goes to a thread of its own, two at a time.
     void index_by_particle(const std::vector<Index>& id, bool parallel)
     {
         const std::size_t n = start.size() - 1;
+        pos_.resize(n);
+        for (std::size_t s = 0; s < n; ++s) pos_[std::size_t(id[s])] = Index(s);
+        earliest.resize(n);
         in_team(parallel, [&] {
 #pragma omp single nowait
-            by_particle(owner, partner, id, n, istart, as_i);
+            bucket_sort(owner, n, by_owner_.start, by_owner_.order);
 #pragma omp single nowait
-            by_particle(partner, owner, id, n, jstart, as_j);
+            bucket_sort(partner, n, by_partner_.start, by_partner_.order);
+#pragma omp barrier
+#pragma omp single nowait
+            deal(owner, by_partner_, by_owner_.start, istart, as_i);
+#pragma omp single nowait
+            {
+                deal(partner, by_owner_, by_partner_.start, jstart, as_j);
+                find_earliest();
+            }
         });
     }
 
-    std::size_t bytes() const { return heap_bytes(start, partner, owner, istart, as_i, jstart, as_j, spans, scan_); }
+    std::size_t bytes() const
+    {
+        return heap_bytes(start, partner, owner, istart, as_i, jstart, as_j, earliest, spans, scan_, pos_) + by_owner_.bytes() +
+               by_partner_.bytes();
+    }
 
 private:
-    // The slots by `key` (bucket_sort), each particle's by the id of `other`: a handful a particle, so an
-    // insertion sort, each key looked up once.
-    static void by_particle(const std::vector<Index>& key, const std::vector<Index>& other, const std::vector<Index>& id, std::size_t n,
-                            std::vector<Index>& first, std::vector<Index>& order)
+    // Slots grouped by particle (bucket_sort), in no order that matters within a group.
+    struct Grouping {
+        std::vector<Index> start, order;
+        std::size_t bytes() const { return heap_bytes(start, order); }
+    };
+
+    // The slots by `key` (starting at key_start, its grouping's), each key's by ascending id of the other
+    // particle of the pair (as_i: key owner, other partner; as_j the reverse): the groups of the other
+    // (by_other) taken in ascending id of their particle, each slot dealt to its key's group in turn, so
+    // that each key's slots come in ascending id of the other (a pair is listed once).
+    void deal(const std::vector<Index>& key, const Grouping& by_other, const std::vector<Index>& key_start, std::vector<Index>& first,
+              std::vector<Index>& order) const
     {
-        bucket_sort(key, n, first, order);
-        const Index* po = other.data();
-        const Index* pid = id.data();
-        Index* slots = order.data();
-        for (std::size_t s = 0; s < n; ++s) {
-            Index* const begin = slots + first[s];
-            Index* const end = slots + first[s + 1];
-            for (Index* a = begin + 1; a < end; ++a) {
-                const Index k = *a, at = pid[po[k]];
-                Index* b = a;
-                for (; b > begin && pid[po[b[-1]]] > at; --b) *b = b[-1];
-                *b = k;
+        const std::size_t n = start.size() - 1;
+        first = key_start;
+        order.resize(key.size());
+        const Index* pkey = key.data();
+        const Index* grouped = by_other.order.data();
+        const Index* group_start = by_other.start.data();
+        Index* next = first.data();  // each key's next place: its start, until dealt to, then its end
+        for (std::size_t i = 0; i < n; ++i) {
+            const std::size_t o = std::size_t(pos_[i]);
+            for (Index e = group_start[o]; e < group_start[o + 1]; ++e) {
+                const Index k = grouped[e];
+                order[std::size_t(next[pkey[k]]++)] = k;
             }
+        }
+        for (std::size_t b = n; b > 0; --b) first[b] = first[b - 1];  // back to starts
+        first[0] = 0;
+    }
+
+    // earliest[s]: the slots stored at s are [start[s], start[s + 1]), each with a partner q above s.
+    // Going down the storage, each s writes itself as the earliest of those partners: the last to write
+    // one, the lowest, stays. None above s writes s's, so s starts as its own before those below it come.
+    void find_earliest()
+    {
+        const std::size_t n = start.size() - 1;
+        const Index* po = owner.data();
+        const Index* pp = partner.data();
+        Index* out = earliest.data();
+        for (std::size_t s = n; s-- > 0;) {
+            out[s] = Index(s);
+            for (Index k = start[s]; k < start[s + 1]; ++k) out[std::size_t(po[k] + pp[k]) - s] = Index(s);
         }
     }
 
     std::vector<std::vector<Index>> scan_;  // per thread: partners found by the scan
+    std::vector<Index> pos_;                // index_by_particle: the storage slot of each id
+    Grouping by_owner_, by_partner_;        // index_by_particle: the slots by each particle of the pair
 };
 
 } // namespace demmat::fast
