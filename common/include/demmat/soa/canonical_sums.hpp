@@ -298,9 +298,9 @@ private:
     }
 
     // The schedule of the particles by chunk[s]: each chunk's particles (order[start[c] … start[c + 1]),
-    // sorted by their counts of slots as j, so that a group's lists are near one length), kGroup particles
-    // a group, and their tables: a row of ring places a step, the lists as j to the group's longest,
-    // then as i, padded with the place of the ring's slot of zeros (ring_slots).
+    // sorted by their counts of slots as j and as i, so that a group's lists are near one length),
+    // kGroup particles a group, and their tables: a row of ring places a step, the lists as j to the
+    // group's longest, then as i, padded with the place of the ring's slot of zeros (ring_slots).
     void schedule(const NeighbourList& list, const std::vector<Index>& chunk, Schedule& out, Scratch& scratch) const
     {
         const std::size_t nch = chunks(chunk.size());
@@ -321,18 +321,26 @@ private:
         group_start.assign(nch + 1, 0);
         groups.clear();
         for (std::size_t c = 0; c < nch; ++c) {
-            // The chunk's particles by (count as j, storage index): a stable counting sort by count of
+            // The chunk's particles by count as j, and within a count by count as i, ascending for an
+            // even count as j and descending for an odd one: a group that straddles two counts as j
+            // then takes its lists as i from the same end of both, so that fewer are padded (the
+            // groups' rows are the longest list of each kind). A stable counting sort by that key of
             // the chunk's particles, which order holds by storage index.
             const Index* const in = order.data() + start[c];
             const std::size_t size = std::size_t(start[c + 1] - start[c]);
-            auto count_of = [&](Index s) { return std::size_t(jstart[s + 1] - jstart[s]); };
+            std::size_t most_i = 0;
+            for (std::size_t e = 0; e < size; ++e) most_i = std::max(most_i, std::size_t(istart[in[e] + 1] - istart[in[e]]));
+            auto key_of = [&](Index s) {
+                const std::size_t j = std::size_t(jstart[s + 1] - jstart[s]), i = std::size_t(istart[s + 1] - istart[s]);
+                return j * (most_i + 1) + (j % 2 == 0 ? i : most_i - i);
+            };
             std::size_t most = 0;
-            for (std::size_t e = 0; e < size; ++e) most = std::max(most, count_of(in[e]));
+            for (std::size_t e = 0; e < size; ++e) most = std::max(most, key_of(in[e]));
             scratch.at.assign(most + 2, 0);
-            for (std::size_t e = 0; e < size; ++e) ++scratch.at[count_of(in[e]) + 1];
+            for (std::size_t e = 0; e < size; ++e) ++scratch.at[key_of(in[e]) + 1];
             for (std::size_t k = 0; k <= most; ++k) scratch.at[k + 1] += scratch.at[k];
             scratch.grain.resize(size);
-            for (std::size_t e = 0; e < size; ++e) scratch.grain[std::size_t(scratch.at[count_of(in[e])]++)] = in[e];
+            for (std::size_t e = 0; e < size; ++e) scratch.grain[std::size_t(scratch.at[key_of(in[e])]++)] = in[e];
             for (std::size_t g0 = 0; g0 < size; g0 += kGroup) {
                 Group g;
                 g.count = std::int32_t(std::min<std::size_t>(kGroup, size - g0));
