@@ -120,11 +120,11 @@ public:
             bucket_sort(partner, n, by_partner_.start, by_partner_.order);
 #pragma omp barrier
 #pragma omp single nowait
-            deal(owner, by_partner_, by_owner_.start, istart, as_i);
+            deal(partner, by_owner_, by_partner_.start, jstart, as_j);
 #pragma omp single nowait
             {
-                deal(partner, by_owner_, by_partner_.start, jstart, as_j);
-                find_earliest();
+                deal(owner, by_partner_, by_owner_.start, istart, as_i);
+                find_earliest();  // with the shorter of the two deals
             }
         });
     }
