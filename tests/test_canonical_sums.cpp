@@ -5,7 +5,9 @@
 // runs only the table form its target's width picks, so the equivalence tests see one of them on a
 // given machine; this runs both here, on a list with random slot values of mixed magnitudes, where
 // any change of order, sign or lane changes bits. The sum alone is checked in turn against the order
-// written out from every slot of the list, with ids that do not follow storage.
+// written out from every slot of the list, with ids that do not follow storage. The list's per-particle
+// indexes (as_i, as_j, earliest), made at each rebuild by counting sorts, and the plan's chunk range
+// are checked against the same rules, from one thread and from a team.
 #include <gtest/gtest.h>
 #include <omp.h>
 
