@@ -50,7 +50,9 @@ NeighbourList random_list(std::size_t n, std::size_t window, std::mt19937_64& rn
         }
     }
     list.start[n] = Index(list.partner.size());
-    list.index_by_particle(id, false);
+    std::vector<Index> pos(n);
+    for (std::size_t s = 0; s < n; ++s) pos[std::size_t(id[s])] = Index(s);
+    list.index_by_particle(pos, false);
     return list;
 }
 
@@ -118,7 +120,9 @@ TEST(CanonicalSums, IndexesAndPlanFollowTheRulesWrittenOut)
     team.as_i.assign(team.as_i.size(), -1);
     team.as_j.assign(team.as_j.size(), -1);
     team.earliest.assign(n, -1);
-    team.index_by_particle(id, true);
+    std::vector<Index> pos(n);
+    for (std::size_t s = 0; s < n; ++s) pos[std::size_t(id[s])] = Index(s);
+    team.index_by_particle(pos, true);
     omp_set_num_threads(saved);
     EXPECT_EQ(team.istart, list.istart);
     EXPECT_EQ(team.as_i, list.as_i);

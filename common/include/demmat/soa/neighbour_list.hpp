@@ -8,7 +8,6 @@
 // back only to its partners below it in storage, never above, as it did with the slots under the lower id.
 #include <algorithm>
 #include <cstddef>
-#include <cstdint>
 #include <utility>
 #include <vector>
 
@@ -100,18 +99,17 @@ public:
                     ppartner[k] = swap ? Index(s) : q;
                 }
         });
-        if (canonical) index_by_particle(id, parallel);
+        if (canonical) index_by_particle(p.pos, parallel);
     }
 
     // as_i and as_j from owner and partner: each particle's slots as i, by ascending partner id, and as
     // j, by ascending owner id (ids are unique, so the order is total); and earliest. Two counting sorts
     // a side and no comparison: the slots grouped by owner and by partner, then each side dealt from the
-    // other's grouping (deal()). On a team, each of the four goes to a thread of its own, two at a time.
-    void index_by_particle(const std::vector<Index>& id, bool parallel)
+    // other's grouping (deal(), which takes the ids in order through pos, the storage slot of each id).
+    // On a team, each of the four goes to a thread of its own, two at a time.
+    void index_by_particle(const std::vector<Index>& pos, bool parallel)
     {
         const std::size_t n = start.size() - 1;
-        pos_.resize(n);
-        for (std::size_t s = 0; s < n; ++s) pos_[std::size_t(id[s])] = Index(s);
         earliest.resize(n);
         in_team(parallel, [&] {
 #pragma omp single nowait
@@ -120,10 +118,10 @@ public:
             bucket_sort(partner, n, by_partner_.start, by_partner_.order);
 #pragma omp barrier
 #pragma omp single nowait
-            deal(partner, by_owner_, by_partner_.start, jstart, as_j);
+            deal(partner, by_owner_, by_partner_.start, pos, jstart, as_j);
 #pragma omp single nowait
             {
-                deal(owner, by_partner_, by_owner_.start, istart, as_i);
+                deal(owner, by_partner_, by_owner_.start, pos, istart, as_i);
                 find_earliest();  // with the shorter of the two deals
             }
         });
@@ -131,7 +129,7 @@ public:
 
     std::size_t bytes() const
     {
-        return heap_bytes(start, partner, owner, istart, as_i, jstart, as_j, earliest, spans, scan_, pos_) + by_owner_.bytes() +
+        return heap_bytes(start, partner, owner, istart, as_i, jstart, as_j, earliest, spans, scan_) + by_owner_.bytes() +
                by_partner_.bytes();
     }
 
@@ -146,8 +144,8 @@ private:
     // particle of the pair (as_i: key owner, other partner; as_j the reverse): the groups of the other
     // (by_other) taken in ascending id of their particle, each slot dealt to its key's group in turn, so
     // that each key's slots come in ascending id of the other (a pair is listed once).
-    void deal(const std::vector<Index>& key, const Grouping& by_other, const std::vector<Index>& key_start, std::vector<Index>& first,
-              std::vector<Index>& order) const
+    void deal(const std::vector<Index>& key, const Grouping& by_other, const std::vector<Index>& key_start, const std::vector<Index>& pos,
+              std::vector<Index>& first, std::vector<Index>& order) const
     {
         const std::size_t n = start.size() - 1;
         first = key_start;
@@ -157,7 +155,7 @@ private:
         const Index* group_start = by_other.start.data();
         Index* next = first.data();  // each key's next place: its start, until dealt to, then its end
         for (std::size_t i = 0; i < n; ++i) {
-            const std::size_t o = std::size_t(pos_[i]);
+            const std::size_t o = std::size_t(pos[i]);
             for (Index e = group_start[o]; e < group_start[o + 1]; ++e) {
                 const Index k = grouped[e];
                 order[std::size_t(next[pkey[k]]++)] = k;
@@ -170,6 +168,7 @@ private:
     // earliest[s]: the slots stored at s are [start[s], start[s + 1]), each with a partner q above s.
     // Going down the storage, each s writes itself as the earliest of those partners: the last to write
     // one, the lowest, stays. None above s writes s's, so s starts as its own before those below it come.
+    // (Slot k's particle other than s is owner + partner - s.)
     void find_earliest()
     {
         const std::size_t n = start.size() - 1;
@@ -183,7 +182,6 @@ private:
     }
 
     std::vector<std::vector<Index>> scan_;  // per thread: partners found by the scan
-    std::vector<Index> pos_;                // index_by_particle: the storage slot of each id
     Grouping by_owner_, by_partner_;        // index_by_particle: the slots by each particle of the pair
 };
 
