@@ -6,7 +6,7 @@
 // lowest level that covers what its scene needs: the features a level has beyond the need are inert
 // there (μ·F_n or γ_t·m*·|u_t| zero, γ_n·m*·u_n zero, no walls, walls at rest), so the trajectory is
 // the same bit for bit (tests/test_fast.cpp). Each kind is built in a file of its own, so that they
-// compile side by side.
+// compile side by side. Without kAllModels (model.hpp) only the chain's two ends.
 #include <memory>
 
 #include "demmat/model.hpp"
@@ -27,12 +27,17 @@ template <bool Polydisperse, class Make>
 decltype(auto) with_paper_level(int level, Make&& make)
 {
     constexpr bool P = Polydisperse;
-    switch (level) {
-    case 0: return make.template operator()<Model<false, false, false, false, false, P>>();
-    case 1: return make.template operator()<Model<false, false, true, false, false, P>>();
-    case 2: return make.template operator()<Model<true, true, true, false, false, P>>();
-    case 3: return make.template operator()<Model<true, true, true, true, false, P>>();
-    default: return make.template operator()<Model<true, true, true, true, true, P>>();
+    if constexpr (!kAllModels) {  // the chain's two ends (model.hpp)
+        if (level == 0) return make.template operator()<Model<false, false, false, false, false, P>>();
+        return make.template operator()<Model<true, true, true, true, true, P>>();
+    } else {
+        switch (level) {
+        case 0: return make.template operator()<Model<false, false, false, false, false, P>>();
+        case 1: return make.template operator()<Model<false, false, true, false, false, P>>();
+        case 2: return make.template operator()<Model<true, true, true, false, false, P>>();
+        case 3: return make.template operator()<Model<true, true, true, true, false, P>>();
+        default: return make.template operator()<Model<true, true, true, true, true, P>>();
+        }
     }
 }
 

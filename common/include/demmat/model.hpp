@@ -7,7 +7,16 @@
 #include <string>
 #include <utility>
 
+#ifndef DEMMAT_ALL_MODELS
+#define DEMMAT_ALL_MODELS 1
+#endif
+
 namespace demmat {
+
+// Whether this build instantiates every specialised model (CMake's DEMMAT_ALL_MODELS), or only the two
+// ends of each chain: every feature off, every feature on (the sanitizer build, for its compile time;
+// every `if constexpr` on a feature still runs both ways).
+inline constexpr bool kAllModels = DEMMAT_ALL_MODELS != 0;
 
 // The last three flags are the contact laws beyond the paper's (physics.md §9, contact_memory.hpp); their
 // defaults are the paper's law, so Model<R, F, D, W, MW, P> is the very type it was before they existed.
@@ -98,23 +107,31 @@ decltype(auto) branch(bool on, F&& f)
 // smallest cover of a real scene: friction without rotation (no torque without a tangential force is
 // impossible to use) and rotation without friction (rotation is needed without friction only to carry
 // a given initial spin; the rotation+friction model then runs, exactly, with μ·F_n or γ_t·m*·|u_t|
-// zero), moving walls without walls.
+// zero), moving walls without walls. Without kAllModels the set is 2 × 2: the need's polydispersity
+// with every other feature off (a scene that needs none of them) or on.
 template <class Make>
 decltype(auto) with_model(const ModelFeatures& need, Make&& make)
 {
-    const bool spin = need.rotation || need.friction;
-    const int walls = need.moving_walls ? 2 : need.walls ? 1 : 0;
-    return detail::branch(spin, [&]<bool RF>() -> decltype(auto) {
-        return detail::branch(need.damping, [&]<bool D>() -> decltype(auto) {
-            return detail::branch(need.polydisperse, [&]<bool P>() -> decltype(auto) {
-                switch (walls) {
-                case 0: return make.template operator()<Model<RF, RF, D, false, false, P>>();
-                case 1: return make.template operator()<Model<RF, RF, D, true, false, P>>();
-                default: return make.template operator()<Model<RF, RF, D, true, true, P>>();
-                }
+    if constexpr (!kAllModels) {
+        const bool any = need.rotation || need.friction || need.damping || need.walls || need.moving_walls;
+        return detail::branch(any, [&]<bool A>() -> decltype(auto) {
+            return detail::branch(need.polydisperse, [&]<bool P>() -> decltype(auto) { return make.template operator()<Model<A, A, A, A, A, P>>(); });
+        });
+    } else {
+        const bool spin = need.rotation || need.friction;
+        const int walls = need.moving_walls ? 2 : need.walls ? 1 : 0;
+        return detail::branch(spin, [&]<bool RF>() -> decltype(auto) {
+            return detail::branch(need.damping, [&]<bool D>() -> decltype(auto) {
+                return detail::branch(need.polydisperse, [&]<bool P>() -> decltype(auto) {
+                    switch (walls) {
+                    case 0: return make.template operator()<Model<RF, RF, D, false, false, P>>();
+                    case 1: return make.template operator()<Model<RF, RF, D, true, false, P>>();
+                    default: return make.template operator()<Model<RF, RF, D, true, true, P>>();
+                    }
+                });
             });
         });
-    });
+    }
 }
 
 // with_model, and also the laws of physics.md §9: a scene with the paper's law gets exactly with_model's
