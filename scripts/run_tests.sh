@@ -46,7 +46,10 @@ if [[ $which != normal ]]; then
   # RelWithDebInfo, which DEMMAT_SANITIZE turns into -O1 -g1 (CMakeLists.txt): line numbers in the reports.
   # The ends of each chain of specialised models only (every feature off, every feature on): every
   # `if constexpr` on a feature still runs both ways, in a fraction of the compile time (docs/testing.md).
-  run_build "$asan_dir" -DDEMMAT_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDEMMAT_BUILD_BENCH=OFF -DDEMMAT_ALL_MODELS=OFF
+  # The gtest cases as 16 shards, 16 processes, not one per case: an instrumented process takes a third
+  # of a second to start (docs/testing.md).
+  run_build "$asan_dir" -DDEMMAT_SANITIZE=ON -DCMAKE_BUILD_TYPE=RelWithDebInfo -DDEMMAT_BUILD_BENCH=OFF -DDEMMAT_ALL_MODELS=OFF \
+    -DDEMMAT_TEST_SHARDS=16
 fi
 if [[ $which == both ]]; then
   normal=$("$(demmat_in "$BUILD_DIR")" list | awk '{print $1}' | tr '\n' ' ')
