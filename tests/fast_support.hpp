@@ -60,7 +60,8 @@ inline LockstepResult lockstep(const Setup& setup, std::int64_t steps, const std
         set_threads(r.threads);
         FastOptions o = r.options;
         o.min_parallel = 0;   // the threads asked for, however small the scene
-        o.prefetch_from = 0;  // and the kernel's prefetching path
+        o.prefetch_from = 0;  // and the kernel's prefetching path,
+        o.stream_records_from = 0;  // and predict()'s streamed records
         fast.push_back(make_fast_variant(o));
         drivers.push_back(std::make_unique<Driver>(*fast.back(), setup));
     }

@@ -26,13 +26,14 @@ using namespace demmat::test;
 
 namespace {
 
-// fast_unordered's options, on the threads asked for and on the prefetching path however small the scene.
+// fast_unordered's options, on the threads asked for and on the prefetching and streaming paths however small the scene.
 FastOptions threaded_unordered()
 {
     FastOptions o;
     o.canonical = false;
     o.min_parallel = 0;
     o.prefetch_from = 0;
+    o.stream_records_from = 0;
     return o;
 }
 
@@ -206,6 +207,7 @@ TEST(Fast, PhasesOnTeamsOfDifferentSizesGiveTheSameTrajectory)
     FastOptions o;
     o.min_parallel = 0;
     o.prefetch_from = 0;
+    o.stream_records_from = 0;
     auto fast = make_fast_variant(o);
     fast->init(c.setup());
     VariantRun ref("arrays", c.setup());

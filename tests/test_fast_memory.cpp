@@ -164,6 +164,7 @@ TEST(FastMemory, PhasesOnTeamsOfChangingSizesGiveArraysBits)
     FastOptions o = skin(0.1);
     o.min_parallel = 0;
     o.prefetch_from = 0;
+    o.stream_records_from = 0;
     auto fast = make_fast_variant(o);
     fast->init(p->setup());
     VariantRun ref("arrays", p->setup());

@@ -26,6 +26,12 @@ struct FastOptions {
     // "fast"; a hint to the caches, which changes no result). The tests set 0, so that their small
     // scenes take that path too.
     std::size_t prefetch_from = 8000;
+    // From this many particles on, predict()'s pass writes the kernels' records with non-temporal stores
+    // (Particles::refresh_records): well past the last-level cache the records leave it before the force
+    // pass reads them, and a plain store first reads each line it overwrites; nearer the cache's size
+    // they would have stayed (docs/variants.md, "fast"; no result changes). The tests set 0, so that
+    // their small scenes take that path too.
+    std::size_t stream_records_from = 48000;
 };
 
 class FastVariant : public Variant {

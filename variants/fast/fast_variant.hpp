@@ -68,6 +68,7 @@ public:
         // Below min_parallel one thread: a fork and join per phase would cost more than the work shared.
         par_ = p_.n >= opt_.min_parallel;
         prefetch_ = p_.n >= opt_.prefetch_from;
+        stream_ = p_.n >= opt_.stream_records_from;
         skin_ = opt_.skin * setup.radius_max;
         // Cells at least as wide as the longest listed pair; a wider scene cell is honoured (it only
         // changes the candidates, never the contact set).
@@ -116,9 +117,11 @@ public:
                 const std::size_t b1 = std::min(hi, b0 + kPassBlock);
                 p_.template integrate<M::rotation>(b0, b1, fused);
                 mine |= p_.moved_too_far(b0, b1, half * half);
-                p_.refresh_records(b0, b1);
+                if (stream_) p_.template refresh_records<true>(b0, b1);
+                else p_.refresh_records(b0, b1);
                 if constexpr (M::walls) walls_.list(p_, b0, b1, t);
             }
+            if (stream_) p_.records_fence();  // before the team's barrier, after which others read them
             walls_.size_results(t);
             if (mine) over.store(1, std::memory_order_relaxed);
         });
@@ -252,7 +255,7 @@ private:
     }
 
     FastOptions opt_;
-    bool par_ = true, prefetch_ = false;
+    bool par_ = true, prefetch_ = false, stream_ = false;
     bool rebuild_due_ = false;  // the displacement check of the last predict() asks for a rebuild
     std::int64_t step_ = 0, rebuilds_ = 0;
     double skin_ = 0.0, cell_ = 0.0;

@@ -8,6 +8,9 @@
 #include <cstddef>
 #include <cstring>
 #include <vector>
+#ifdef __AVX__
+#include <immintrin.h>
+#endif
 
 #include "demmat/contact_law.hpp"
 #include "demmat/gear.hpp"
@@ -130,7 +133,12 @@ public:
 
     // The kernels' records for [lo, hi), from the state arrays: four particles at a time, a quad of each
     // array transposed into their four records (fewer instructions than a record at a time from scalar
-    // loads), the rest one by one.
+    // loads), the rest one by one. Stream (where the target has AVX): the four records' six whole cache
+    // lines by non-temporal stores, which do not read each line before writing it, nor keep it in the
+    // caches: for a pass over more particles than the caches hold, whose records are gone from them
+    // before the force pass reads them anyway (FastOptions::stream_records_from). Such stores are
+    // weakly ordered: the thread calls records_fence() before another may read the records.
+    template <bool Stream = false>
     void refresh_records(std::size_t lo, std::size_t hi)
     {
         const double* __restrict px = x.data();
@@ -145,6 +153,16 @@ public:
             load_quad(qb, c + n + s);
             load_quad(qd, c + 2 * n + s);
             transpose4(qa, qb, qd, qe);
+#ifdef __AVX__
+            if constexpr (Stream) {
+                auto stream = [](Quad& to, const Quad& q) { _mm256_stream_pd(reinterpret_cast<double*>(&to), __m256d(q)); };
+                stream(rec[s].*field, qa);
+                stream(rec[s + 1].*field, qb);
+                stream(rec[s + 2].*field, qd);
+                stream(rec[s + 3].*field, qe);
+                return;
+            }
+#endif
             rec[s].*field = qa;
             rec[s + 1].*field = qb;
             rec[s + 2].*field = qd;
@@ -164,6 +182,14 @@ public:
             rec[s].v = Quad{pv[s], pv[n + s], pv[2 * n + s], pm[s]};
             rec[s].w = Quad{pw[s], pw[n + s], pw[2 * n + s], 0.0};
         }
+    }
+
+    // Orders this thread's streamed records (refresh_records<true>) before whatever it stores next.
+    static void records_fence()
+    {
+#ifdef __AVX__
+        _mm_sfence();
+#endif
     }
 
     // Particle s's six Gear values (x, v, a, b3, b4, b5) for translation or rotation, as the step's
