@@ -103,14 +103,13 @@ def cmd_compare(a):
     df = pd.DataFrame(rows)
     os.makedirs(a.out, exist_ok=True)
     write_text(os.path.join(a.out, "single_contacts.csv"), df.to_csv(index=False, float_format="%.3e"))
-    builds = []
+    builds, cpu = [], platform.machine()
     for spec in a.build:
         name, exe = spec.split("=", 1)
         out = subprocess.run([exe, "--version"], capture_output=True, text=True, check=True).stdout.split("\n")
         info = dict(line.split(" ", 1) for line in out[1:] if " " in line)
         builds.append(f"{name}: commit {info.get('commit', '?')[:10]}, {info.get('compiler', '?')}, `{info.get('flags', '?')}`")
-    with open("/proc/cpuinfo") as f:
-        cpu = next((l.split(":", 1)[1].strip() for l in f if l.startswith("model name")), platform.machine())
+        cpu = info.get("cpu", cpu)  # as every result names it (provenance.cpp)
     lines = ["# Single contacts: the suite against LAMMPS, contact by contact", "",
              f"Four grains, no gravity, the contact law of the physics cross-check ({versions.get('contact_law', 'the paper')}), "
              f"{STEPS} steps; each grain makes one contact in isolation. Largest difference from LAMMPS over "

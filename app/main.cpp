@@ -521,8 +521,8 @@ int main(int argc, char** argv)
     app.set_help_all_flag("--help-all", "Help for every subcommand");
     app.set_version_flag("--version", [] {
         const Provenance& p = build_provenance();
-        return fmt::format("demmat {}\ncommit {}{}\ncompiler {}\nflags {}\nbuild type {}", DEMMAT_VERSION, p.commit,
-                           p.dirty ? " (dirty)" : "", p.compiler, p.flags, p.build_type);
+        return fmt::format("demmat {}\ncommit {}{}\ncompiler {}\nflags {}\nbuild type {}\ncpu {}", DEMMAT_VERSION, p.commit,
+                           p.dirty ? " (dirty)" : "", p.compiler, p.flags, p.build_type, cpu_model());
     });
 
     auto* list = app.add_subcommand("list", "List the registered variants, one per line, name first");
