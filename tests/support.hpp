@@ -22,10 +22,10 @@ inline std::vector<std::string> variant_names() { return registry().names(); }
 
 // The length of a long equivalence run (thousands of contact-rich steps). The sanitizer build
 // (DEMMAT_SANITIZE) runs a fifth of it, and no fewer than 50 steps: it hunts memory errors and
-// undefined behaviour, which the first few hundred steps of every path already exercise (the beds start
-// contact-rich; the list is rebuilt every ten to twenty steps on the compression stage; contacts are made
-// and broken), while the normal build checks the full trajectories bit for bit. This keeps CI within its
-// time.
+// undefined behaviour, which the first few hundred steps of every path already exercise (the settled
+// beds are contact-rich from the start and the loose one within a few hundred steps, which its test
+// checks; the list is rebuilt every ten to twenty steps on the compression stage; contacts are made and
+// broken), while the normal build checks the full trajectories bit for bit. This keeps CI within its time.
 #ifdef DEMMAT_SANITIZED
 inline constexpr std::int64_t kLongRunDivisor = 5;
 #else
