@@ -97,6 +97,20 @@ def cmd_bench(a):
     write_bench(pd.DataFrame(rows), provenance, json.load(open(a.versions)), a.out, a.figure)
 
 
+def paired_ratios(df):
+    """Each code's time over LAMMPS's in the same repetition (the two run side by side), per code, stage
+    and N: the median and the range over the repetitions. Robust to a shared machine's slower hours, which
+    move both samples of a repetition alike, where the ratio of the medians may pair a quiet hour's
+    sample with a loaded one's."""
+    tot = df[df.phase == "total"]
+    lam = tot[tot.code == "lammps"].set_index(["stage", "particles", "repetition"])["us_per_particle_step"]
+    key = list(zip(tot.stage, tot.particles, tot.repetition))
+    r = tot.assign(paired=[t / lam.get(k, float("nan")) for t, k in zip(tot.us_per_particle_step, key)]).dropna(subset=["paired"])
+    g = r.groupby(["code", "variant", "stage", "particles"])["paired"]
+    return g.median().rename("paired_ratio").to_frame().join(g.min().rename("paired_min")).join(
+        g.max().rename("paired_max")).reset_index()
+
+
 def write_bench(df, provenance, versions, out, figure):
     """Medians, ratios to LAMMPS, bench_peers.{csv,json,md} in out, and the figure, from every sample."""
     if df.empty:
@@ -108,6 +122,7 @@ def write_bench(df, provenance, versions, out, figure):
         .join(g.count().rename("repetitions")).reset_index()
     lam = med[med.code == "lammps"].set_index(["stage", "particles"])["median"]
     med["ratio_to_lammps"] = [r["median"] / lam.get((r["stage"], r["particles"]), float("nan")) for _, r in med.iterrows()]
+    med = med.merge(paired_ratios(df), on=["code", "variant", "stage", "particles"], how="left")
     os.makedirs(out, exist_ok=True)
     csv = os.path.join(out, "bench_peers.csv")
     write_text(csv, med.to_csv(index=False, float_format="%.6g"))
@@ -151,7 +166,8 @@ def write_bench(df, provenance, versions, out, figure):
              f"LAMMPS {versions.get('lammps', '?')} (Debian {versions.get('lammps_package', '?')}), "
              + (f"LIGGGHTS {versions['liggghts']} (Debian {versions.get('liggghts_package', '?')}); " if versions.get("liggghts") else "no LIGGGHTS; ")
              + f"suite commit {(provenance or {}).get('commit', '?')}, {(provenance or {}).get('compiler', '?')}, "
-             f"CPU {cpu}. Ratio < 1: faster than LAMMPS. Produced by scripts/run_peers.sh; every sample in bench_peers.json.", "",
+             f"CPU {cpu}. Ratio < 1: faster than LAMMPS. Per stage, the ratio of the medians, then the paired ratios. "
+             f"Produced by scripts/run_peers.sh; every sample in bench_peers.json.", "",
              f"Contact law: {versions.get('contact_law', 'the paper' + chr(39) + 's (physics.md section 2)')}.", ""]
     ns = sorted(med.particles.unique())
     for stage in STAGES:
@@ -168,6 +184,17 @@ def write_bench(df, provenance, versions, out, figure):
             lines.append(f"| {v} | " + " | ".join(cells) + " |")
         lam_row = [m[(m.variant == 'lammps') & (m.particles == n)]["median"] for n in ns]
         lines.append("| *LAMMPS µs per particle-step* | " + " | ".join("" if r.empty else f"{r.iloc[0]:.3f}" for r in lam_row) + " |")
+        lines += ["", "Paired: each repetition's own ratio (the code and LAMMPS run side by side), median (min–max).", "",
+                  "| code | " + " | ".join(f"N = {n}" for n in ns) + " |",
+                  "|---|" + "---:|" * len(ns)]
+        for v in order:
+            if v == "lammps":
+                continue
+            cells = []
+            for n in ns:
+                r = m[(m.variant == v) & (m.particles == n)]
+                cells.append("" if r.empty else f"{r.paired_ratio.iloc[0]:.2f} ({r.paired_min.iloc[0]:.2f}–{r.paired_max.iloc[0]:.2f})")
+            lines.append(f"| {v} | " + " | ".join(cells) + " |")
         lines.append("")
     lines += phase_table(phases, "bed")
     write_text(os.path.join(out, "bench_peers.md"), "\n".join(lines))

@@ -7,6 +7,7 @@ Benchmark JSON (fast on the settled bed of 8000 at 1 and 2 threads, two STREAM k
 mpi_bench_sample.json of `mpirun -np 2 demmat_mpi bench --json` (the loose bed of 2000, two repetitions).
 Run by ctest (analysis.results) with /usr/bin/python3.
 """
+import json
 import os
 import shutil
 import subprocess
@@ -280,6 +281,24 @@ class PeersBench(unittest.TestCase):
         self.assertEqual(cells["lammps/rest"], "0.0200")
         ratio = [line for line in text.splitlines() if line.startswith("| fast |")][0].split("|")[2].strip()
         self.assertEqual(ratio, f"{(2e-5 + 3e-6 + 5e-5) / 1.01e-4:.2f}")  # totals only in the ratio table
+
+    def test_paired_ratio_takes_each_repetition_against_its_own_lammps_run(self):
+        import pandas as pd
+        rows = []
+        # A slow hour hits repetition 2 of both codes: the ratio of the medians pairs 2 with 9 (0.22), each
+        # repetition's own ratio is 1/3, 2/9 and 6/18, median 1/3.
+        for rep, (suite, lammps) in enumerate([(1e-5, 3e-5), (2e-5, 9e-5), (6e-5, 18e-5)]):
+            rows.append({"code": "suite", "variant": "fast", "particles": 1000, "stage": "bed", "repetition": rep,
+                         "steps": 1000, "phase": "total", "seconds_per_step": suite})
+            rows.append({"code": "lammps", "variant": "lammps", "particles": 1000, "stage": "bed", "repetition": rep,
+                         "steps": 1000, "phase": "total", "seconds_per_step": lammps})
+        self.peers.write_bench(pd.DataFrame(rows), {}, {"lammps": "test"}, self.work, os.path.join(self.work, "f.png"))
+        fast = [line for line in open(os.path.join(self.work, "bench_peers.md")).read().splitlines() if line.startswith("| fast |")]
+        self.assertEqual(fast[0].split("|")[2].strip(), "0.22")               # the ratio of the medians
+        self.assertEqual(fast[1].split("|")[2].strip(), "0.33 (0.22–0.33)")   # paired: median (min–max)
+        summary = json.load(open(os.path.join(self.work, "bench_peers.json")))["summary"]
+        row = [r for r in summary if r["variant"] == "fast"][0]
+        self.assertAlmostEqual(row["paired_ratio"], 1 / 3, places=12)
 
 
 class PeerContacts(unittest.TestCase):
