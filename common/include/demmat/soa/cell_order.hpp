@@ -1,8 +1,8 @@
 #pragma once
 // The fast variant's cell order: at each rebuild the particles are sorted by the cell they are in, the
 // box's shortest axis fastest, so that the particles a pair can join (the 27 cells around) lie as close
-// in storage as the box allows (in a flat bed, a slice across its longest axis); then "near" is a scan
-// of three key ranges per row of cells.
+// in storage as the box allows (in a flat bed, a slice across its longest axis); then a particle's
+// later neighbours are a scan of five key ranges, its own row of cells and the four after it.
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -91,25 +91,31 @@ public:
 
     const Key& key(std::size_t s) const { return key_[s]; }
 
-    // Calls f(q) for every slot q in the 27 cells around slot s's cell (s itself included), once the
-    // particles are in the sorted order.
+    // Calls f(q), in ascending q, for every slot q after s in the 27 cells around slot s's cell, once the
+    // particles are in the sorted order: a pair is listed once, by the particle that comes first. The
+    // cells are visited as rows of three along the fastest axis; the rows below s's own (keys all lower)
+    // hold no later slot, and in its own row the later slots start right after s, so only s's own row
+    // and the four rows above it are scanned, half of the 27 cells.
     template <class F>
-    void for_each_near(std::size_t s, F&& f) const
+    void for_each_later(std::size_t s, F&& f) const
     {
         const std::uint64_t k = key_[s].cell;
         const auto dx = std::uint64_t(dims_[0]), dxy = dx * std::uint64_t(dims_[1]);
         auto below = [](const Key& e, std::uint64_t v) { return e.cell < v; };
-        for (int dz = -1; dz <= 1; ++dz)
-            for (int dy = -1; dy <= 1; ++dy) {
-                const std::uint64_t row = k + std::uint64_t(std::int64_t(dz) * std::int64_t(dxy) + std::int64_t(dy) * std::int64_t(dx));
-                if (dense_) {
-                    for (Index t = cstart_[row - 1]; t < cstart_[row + 2]; ++t) f(std::size_t(t));
-                    continue;
-                }
-                const auto b = std::lower_bound(key_.begin(), key_.end(), row - 1, below);
-                const auto e = std::lower_bound(b, key_.end(), row + 2, below);
-                for (auto it = b; it != e; ++it) f(std::size_t(it - key_.begin()));
-            }
+        // [from, to): the slots of cells lo … hi (cells of one row are consecutive keys).
+        auto scan = [&](std::size_t from, std::uint64_t hi) {
+            const std::size_t to = dense_ ? std::size_t(cstart_[hi + 1])
+                                          : std::size_t(std::lower_bound(key_.begin() + std::ptrdiff_t(from), key_.end(), hi + 1, below) - key_.begin());
+            for (std::size_t q = from; q < to; ++q) f(q);
+        };
+        auto row = [&](std::uint64_t centre) {
+            const std::size_t from = dense_ ? std::size_t(cstart_[centre - 1])
+                                            : std::size_t(std::lower_bound(key_.begin(), key_.end(), centre - 1, below) - key_.begin());
+            scan(from, centre + 1);
+        };
+        scan(s + 1, k + 1);  // s's own row: the rest of its cell, and the cell after it
+        row(k + dx);         // the row above in the middle axis, then the three of the slowest axis's next layer
+        for (std::uint64_t dy = 0; dy < 3; ++dy) row(k + dxy + dy * dx - dx);
     }
 
     std::size_t bytes() const { return heap_bytes(key_, keytmp_, cell3_, cstart_); }

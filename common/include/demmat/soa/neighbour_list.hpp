@@ -57,7 +57,7 @@ public:
         const std::vector<Index>& id = p.id;
         // may_touch with each radius grown by skin/2: pairs closer than R_i + R_j + skin, with the law's margin.
         auto near = [&](std::size_t s, std::size_t q) {
-            return q > s && may_touch(p.get(p.x, s), p.get(p.x, q), p.r[s] + half_skin, p.r[q] + half_skin);
+            return may_touch(p.get(p.x, s), p.get(p.x, q), p.r[s] + half_skin, p.r[q] + half_skin);
         };
         start.assign(n + 1, 0);
         Index* pstart = start.data();
@@ -68,7 +68,7 @@ public:
             mine.clear();
             for (std::size_t s = lo; s < hi; ++s) {
                 const std::size_t before = mine.size();
-                cells.for_each_near(s, [&](std::size_t q) {
+                cells.for_each_later(s, [&](std::size_t q) {
                     if (near(s, q)) mine.push_back(Index(q));
                 });
                 pstart[s + 1] = Index(mine.size() - before);
