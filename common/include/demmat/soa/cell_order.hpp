@@ -91,22 +91,23 @@ public:
 
     const Key& key(std::size_t s) const { return key_[s]; }
 
-    // Calls f(q), in ascending q, for every slot q after s in the 27 cells around slot s's cell, once the
-    // particles are in the sorted order: a pair is listed once, by the particle that comes first. The
-    // cells are visited as rows of three along the fastest axis; the rows below s's own (keys all lower)
-    // hold no later slot, and in its own row the later slots start right after s, so only s's own row
-    // and the four rows above it are scanned, half of the 27 cells.
+    // Calls f(from, to) for runs of slots [from, to), in ascending order, that together hold every slot
+    // after s in the 27 cells around slot s's cell, once the particles are in the sorted order: a pair is
+    // listed once, by the particle that comes first. The cells are visited as rows of three along the
+    // fastest axis (a row's cells are consecutive keys, so one run); the rows below s's own (keys all
+    // lower) hold no later slot, and in its own row the later slots start right after s, so only s's own
+    // row and the four rows above it are scanned, half of the 27 cells.
     template <class F>
     void for_each_later(std::size_t s, F&& f) const
     {
         const std::uint64_t k = key_[s].cell;
         const auto dx = std::uint64_t(dims_[0]), dxy = dx * std::uint64_t(dims_[1]);
         auto below = [](const Key& e, std::uint64_t v) { return e.cell < v; };
-        // [from, to): the slots of cells lo … hi (cells of one row are consecutive keys).
+        // [from, to): from a slot up to the end of cell hi.
         auto scan = [&](std::size_t from, std::uint64_t hi) {
             const std::size_t to = dense_ ? std::size_t(cstart_[hi + 1])
                                           : std::size_t(std::lower_bound(key_.begin() + std::ptrdiff_t(from), key_.end(), hi + 1, below) - key_.begin());
-            for (std::size_t q = from; q < to; ++q) f(q);
+            f(from, to);
         };
         auto row = [&](std::uint64_t centre) {
             const std::size_t from = dense_ ? std::size_t(cstart_[centre - 1])

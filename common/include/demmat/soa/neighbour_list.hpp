@@ -68,8 +68,17 @@ public:
             mine.clear();
             for (std::size_t s = lo; s < hi; ++s) {
                 const std::size_t before = mine.size();
-                cells.for_each_later(s, [&](std::size_t q) {
-                    if (near(s, q)) mine.push_back(Index(q));
+                // Each candidate written, and kept by counting it: no branch on the test's outcome.
+                cells.for_each_later(s, [&](std::size_t a, std::size_t b) {
+                    const std::size_t at = mine.size();
+                    mine.resize(at + (b - a));
+                    Index* out = mine.data() + at;
+                    std::size_t k = 0;
+                    for (std::size_t q = a; q < b; ++q) {
+                        out[k] = Index(q);
+                        k += std::size_t(near(s, q));
+                    }
+                    mine.resize(at + k);
                 });
                 pstart[s + 1] = Index(mine.size() - before);
             }
