@@ -113,10 +113,9 @@ public:
             if (t == 0) listing_team = std::size_t(thread_count());
             walls_.clear_list(t);
             int mine = 0;
-            for (std::size_t b0 = lo; b0 < hi; b0 += kPassBlock) {
-                const std::size_t b1 = std::min(hi, b0 + kPassBlock);
-                p_.template integrate<M::rotation>(b0, b1, fused);
-                mine |= p_.moved_too_far(b0, b1, half * half);
+            for (std::size_t b0 = lo; b0 < hi; b0 += Particles::kPassBlock) {
+                const std::size_t b1 = std::min(hi, b0 + Particles::kPassBlock);
+                mine |= p_.template integrate<M::rotation>(b0, b1, fused, half * half);
                 if (stream_) p_.template refresh_records<true>(b0, b1);
                 else p_.refresh_records(b0, b1);
                 if constexpr (M::walls) walls_.list(p_, b0, b1, t);
@@ -216,10 +215,6 @@ public:
     }
 
 private:
-    // Particles per block of predict()'s pass, whose arrays stay in cache from one step of the pass to
-    // the next.
-    static constexpr std::size_t kPassBlock = 1024;
-
     // Re-sorts the particles into cell order, lists the pairs (and plans the canonical sums), carries
     // the pairs' stretches to their new slots, and makes the new storage order's records and wall
     // candidates (predict() made them for the old one).

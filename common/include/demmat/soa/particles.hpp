@@ -79,13 +79,23 @@ public:
         }
     }
 
-    // The Gear step of particles [b0, b1): the pending corrector (accelerations from the last force
-    // pass, a = F/m + g and α = T/I, as Newton's law in arrays) fused with the predictor, or the
-    // predictor alone after init. A component block at a time: seven streams in, six out, vectorised.
-    // Without rotation (a model with !rotation) the rotational state stays as it is: all zeros, as in arrays.
+    // Particles per block of predict()'s pass, whose arrays stay in cache from one step of the pass to
+    // the next (integrate() takes at most this many).
+    static constexpr std::size_t kPassBlock = 1024;
+
+    // The Gear step of particles [b0, b1), at most kPassBlock: the pending corrector (accelerations from
+    // the last force pass, a = F/m + g and α = T/I, as Newton's law in arrays) fused with the predictor,
+    // or the predictor alone after init. A component block at a time: seven streams in, six out,
+    // vectorised. Without rotation (a model with !rotation) the rotational state stays as it is: all
+    // zeros, as in arrays. Returns 1 if a particle of the block has moved farther than sqrt(lim2) since
+    // the last rebuild (or its position is not finite), else 0: the displacement is taken from each
+    // new position as it is stored, in the same loop (a pass of its own would read the positions
+    // again).
     template <bool Rotation>
-    void integrate(std::size_t b0, std::size_t b1, bool fused)
+    int integrate(std::size_t b0, std::size_t b1, bool fused, double lim2)
     {
+        double d2[kPassBlock];  // each particle's squared displacement since the last rebuild, summed x, y, z
+        const double* __restrict xr = xref.data();
         const GearCoefficients<double> k = gear_;
         const double* __restrict mass = m.data();
         const double* __restrict inert = inertia.data();
@@ -98,36 +108,34 @@ public:
             const double* __restrict pf = f.data() + o;
             const double* __restrict pt = t.data() + o;
             const double g = component(g_, c);
+            const double* __restrict xc = xr + o;
             if (fused) {
 #pragma omp simd
-                for (std::size_t s = b0; s < b1; ++s) correct_predict(px[s], pv[s], pa[s], p3[s], p4[s], p5[s], acceleration(pf[s], mass[s], g), k);
+                for (std::size_t s = b0; s < b1; ++s) {
+                    correct_predict(px[s], pv[s], pa[s], p3[s], p4[s], p5[s], acceleration(pf[s], mass[s], g), k);
+                    const double d = px[s] - xc[s];
+                    d2[s - b0] = c == 0 ? d * d : d2[s - b0] + d * d;
+                }
                 if constexpr (Rotation) {
 #pragma omp simd
                     for (std::size_t s = b0; s < b1; ++s) correct_predict(qx[s], qv[s], qa[s], q3[s], q4[s], q5[s], pt[s] / inert[s], k);
                 }
             } else {
 #pragma omp simd
-                for (std::size_t s = b0; s < b1; ++s) gear_predict(px[s], pv[s], pa[s], p3[s], p4[s], p5[s], k);
+                for (std::size_t s = b0; s < b1; ++s) {
+                    gear_predict(px[s], pv[s], pa[s], p3[s], p4[s], p5[s], k);
+                    const double d = px[s] - xc[s];
+                    d2[s - b0] = c == 0 ? d * d : d2[s - b0] + d * d;
+                }
                 if constexpr (Rotation) {
 #pragma omp simd
                     for (std::size_t s = b0; s < b1; ++s) gear_predict(qx[s], qv[s], qa[s], q3[s], q4[s], q5[s], k);
                 }
             }
         }
-    }
-
-    // Has a particle of [b0, b1) moved farther than sqrt(lim2) since the last rebuild (or is its
-    // position not finite)? 1 if so.
-    int moved_too_far(std::size_t b0, std::size_t b1, double lim2) const
-    {
-        const double* __restrict px = x.data();
-        const double* __restrict xr = xref.data();
         int over = 0;
 #pragma omp simd reduction(| : over)
-        for (std::size_t s = b0; s < b1; ++s) {
-            const double dx = px[s] - xr[s], dy = px[n + s] - xr[n + s], dz = px[2 * n + s] - xr[2 * n + s];
-            over |= int(!(dx * dx + dy * dy + dz * dz <= lim2));
-        }
+        for (std::size_t e = 0; e < b1 - b0; ++e) over |= int(!(d2[e] <= lim2));
         return over;
     }
 
