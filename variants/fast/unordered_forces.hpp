@@ -67,7 +67,7 @@ public:
     std::size_t bytes() const { return heap_bytes(loads_); }
 
 private:
-    std::vector<std::vector<Load>> loads_;  // per thread: loads in storage order
+    PerThread<std::vector<Load>> loads_;  // loads in storage order
 };
 
 } // namespace demmat::fast

@@ -208,7 +208,7 @@ private:
     std::vector<std::size_t> piece_chunk_;
     std::unique_ptr<Claim[]> claims_;  // per piece
     std::size_t nclaims_ = 0;
-    std::vector<SlotStore> rings_;  // per thread
+    PerThread<SlotStore> rings_;
     SlotStore all_;                 // every slot, where the sums that straddle two pieces read (several pieces)
 };
 

@@ -5,12 +5,14 @@
 
 namespace demmat::fast {
 
-// Vectors, and vectors of vectors or of parts with a bytes() of their own (their own and their
-// elements' heap).
+// Vectors, vectors of vectors or of parts with a bytes() of their own (their own and their elements'
+// heap), and such parts themselves.
 template <class C>
 std::size_t heap_bytes(const C& c)
 {
-    if constexpr (requires { c.front().capacity(); }) {
+    if constexpr (requires { c.bytes(); }) {
+        return c.bytes();
+    } else if constexpr (requires { c.front().capacity(); }) {
         std::size_t b = c.capacity() * sizeof(c.front());
         for (const auto& inner : c) b += heap_bytes(inner);
         return b;

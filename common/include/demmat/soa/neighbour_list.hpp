@@ -190,7 +190,7 @@ private:
         }
     }
 
-    std::vector<std::vector<Index>> scan_;  // per thread: partners found by the scan
+    PerThread<std::vector<Index>> scan_;  // partners found by the scan
     Grouping by_owner_, by_partner_;        // index_by_particle: the slots by each particle of the pair
 };
 

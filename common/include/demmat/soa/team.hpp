@@ -6,10 +6,13 @@
 #include <cstddef>
 #include <cstdint>
 #include <utility>
+#include <vector>
 
 #ifdef _OPENMP
 #include <omp.h>
 #endif
+
+#include "heap_bytes.hpp"
 
 namespace demmat::fast {
 
@@ -52,6 +55,31 @@ void in_team(bool parallel, Body&& body)
 
 // Where each of `team` threads' shares ends (thread_range's ends).
 inline std::size_t range_end(std::size_t n, std::size_t u, std::size_t team) { return n * (u + 1) / team; }
+
+// One T per thread (a list it grows, its ring, its loads), each on cache lines of its own. Side by side
+// in a plain vector, two threads' vector headers would share a line, and each push_back or resize by
+// one would take that line from the other (false sharing): the list's scan ran no faster on two
+// threads than on one.
+template <class T>
+class PerThread {
+public:
+    std::size_t size() const { return cells_.size(); }
+    void resize(std::size_t threads) { cells_.resize(threads); }
+    T& operator[](std::size_t t) { return cells_[t].value; }
+    const T& operator[](std::size_t t) const { return cells_[t].value; }
+    std::size_t bytes() const
+    {
+        std::size_t b = cells_.capacity() * sizeof(Cell);
+        for (const Cell& c : cells_) b += heap_bytes(c.value);
+        return b;
+    }
+
+private:
+    struct alignas(64) Cell {
+        T value;
+    };
+    std::vector<Cell> cells_;
+};
 
 // A piece's claims: the next chunk up (low 32 bits) and one past the next chunk down (high 32 bits);
 // the sweep ends where they meet. One cache line each.

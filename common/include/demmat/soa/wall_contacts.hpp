@@ -54,7 +54,7 @@ public:
             l.first.assign(n, 0);
             l.lists = 0;
             l.range_end.clear();
-            for (auto& c : l.cand) c.clear();
+            for (std::size_t u = 0; u < l.cand.size(); ++u) l.cand[u].clear();
         }
     }
     const std::vector<Wall>& walls() const { return walls_; }
@@ -262,9 +262,9 @@ private:
     struct Listing {
         std::vector<std::uint8_t> near;              // (N) the walls each particle may touch this step, a bit each
         std::vector<Index> first;                    // (N) where a particle marked near a wall has its first candidate
-        std::vector<std::vector<Candidate>> cand;    // per listing thread: the pairs that may touch
-        std::vector<std::vector<Load>> res;          // per listing thread: their force and torque (zeros: no contact)
-        std::vector<std::vector<Quad>> st;           // per listing thread: q_ quads of stretches per candidate
+        PerThread<std::vector<Candidate>> cand;      // per listing thread: the pairs that may touch
+        PerThread<std::vector<Load>> res;            // per listing thread: their force and torque (zeros: no contact)
+        PerThread<std::vector<Quad>> st;             // per listing thread: q_ quads of stretches per candidate
         std::size_t lists = 0;                       // the team that listed them
         std::vector<std::size_t> range_end;          // where each of its ranges ends
     };
