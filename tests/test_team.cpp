@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <cstdint>
 #include <vector>
 
 #include "demmat/soa/team.hpp"
@@ -96,4 +97,23 @@ TEST(Team, SeveralThreadsRunTheBodyOnATeam)
     EXPECT_EQ(seen.singles.load(), 1);
     expect_each_visited_once(seen);
 #endif
+}
+
+// PerThread: each thread's value on cache lines of its own (two threads' vector headers on one line
+// made each resize by one take the line from the other), and its memory account counts what the values
+// hold on the heap.
+TEST(Team, PerThreadValuesShareNoCacheLine)
+{
+    PerThread<std::vector<int>> per;
+    per.resize(4);
+    for (std::size_t t = 0; t < per.size(); ++t) {
+        const auto at = reinterpret_cast<std::uintptr_t>(&per[t]);
+        EXPECT_EQ(at % 64, 0u) << "thread " << t << "'s value does not start a cache line";
+        if (t > 0) {
+            EXPECT_GE(at - reinterpret_cast<std::uintptr_t>(&per[t - 1]), 64u) << "threads " << t - 1 << " and " << t;
+        }
+    }
+    const std::size_t empty = per.bytes();
+    per[2].reserve(1000);
+    EXPECT_EQ(per.bytes(), empty + per[2].capacity() * sizeof(int));
 }
