@@ -49,10 +49,10 @@ public:
         std::uint32_t table = 0;
     };
 
-    // One of the sweep's two schedules (by each particle's last chunk, or by its first): the particles
-    // by chunk (order, from start[chunk]), each chunk's groups (from group_start[chunk]) and their
-    // tables of ring places (schedule(): 8·(k & mask) for slot k, the byte where its t_i.z lies, and an
-    // eighth of where its line does).
+    // The sweep's schedule (by each particle's last chunk): the particles by chunk (order, from
+    // start[chunk]), each chunk's groups (from group_start[chunk]) and their tables of ring places
+    // (schedule(): 8·(k & mask) for slot k, the byte where its t_i.z lies, and an eighth of where its
+    // line does).
     struct Schedule {
         std::vector<Index> start, order, group_start;
         std::vector<Group> groups;
@@ -62,69 +62,54 @@ public:
 
     // Per particle, the chunks where its first and last slots are stored.
     std::vector<Index> first_chunk, last_chunk;
-    // The upward threads' schedule (by last chunk) and the downward threads' (by first chunk, planned
-    // only for a sweep of two threads or more: plan_first()).
-    Schedule by_last, by_first;
-    // The most chunks and slots from a particle's first slot to its last (the sweep's reach): a ring of
-    // ring_slots slots (a power of two, at least that reach) holds every slot a sum reads.
+    // The sweep's schedule, by each particle's last chunk (its own).
+    Schedule by_last;
+    // The most chunks from a particle's first slot to its last (the sweep's span), and a ring of
+    // ring_slots slots (a power of two) that holds every slot a sum reads: at least the slots of any
+    // span_chunks + 1 chunks in a row, where a particle's reach (its first chunk to its last) lies, and
+    // where the downward thread's sums read (canonical_sweep.hpp).
     std::size_t span_chunks = 0, ring_slots = 1;
 
     static std::size_t chunks(std::size_t n) { return (n + kChunk - 1) / kChunk; }
 
     // After a canonical list is built: a particle's sum needs the slots of the chunks from the first
     // where one of its slots is stored (the list's earliest) to its own (a slot is stored with the pair's
-    // particle that comes first, so none of a particle's slots lies above it). The two schedules are
-    // planned side by side on a team of two or more (the list is rebuilt in the timed loop); a team of
-    // one plans only the upward one, all that a sweep of one thread reads.
+    // particle that comes first, so none of a particle's slots lies above it).
     void plan(const NeighbourList& list, std::size_t n, bool parallel)
     {
         const Index* earliest = list.earliest.data();
         const Index* pstart = list.start.data();
         first_chunk.resize(n);
         last_chunk.resize(n);
-        // The most chunks, and slots, from the start of a particle's first chunk to the end of its last.
-        std::atomic<std::size_t> most_chunks{0}, most_slots{0};
+        // The most chunks from a particle's first chunk to its last.
+        std::atomic<std::size_t> most_chunks{0};
         auto raise = [](std::atomic<std::size_t>& to, std::size_t v) {
             for (std::size_t cur = to.load(std::memory_order_relaxed); v > cur && !to.compare_exchange_weak(cur, v, std::memory_order_relaxed);) {
             }
         };
         in_team(parallel, [&] {
-            std::size_t chunks_here = 0, slots_here = 0;
+            std::size_t chunks_here = 0;
 #pragma omp for schedule(static) nowait
             for (std::size_t s = 0; s < n; ++s) {
                 const std::size_t first = std::size_t(earliest[s]) / kChunk, last = s / kChunk;
                 first_chunk[s] = Index(first);
                 last_chunk[s] = Index(last);
                 chunks_here = std::max(chunks_here, last - first);
-                slots_here = std::max(slots_here, std::size_t(pstart[std::min(n, (last + 1) * kChunk)] - pstart[first * kChunk]));
             }
             raise(most_chunks, chunks_here);
-            raise(most_slots, slots_here);
         });
         span_chunks = most_chunks.load();
-        const std::size_t reach = most_slots.load();
+        // The most slots in span_chunks + 1 chunks in a row.
+        const std::size_t nch = chunks(n);
+        std::size_t reach = 0;
+        for (std::size_t c = 0; c < nch; ++c)
+            reach = std::max(reach, std::size_t(pstart[std::min(n, (c + span_chunks + 1) * kChunk)] - pstart[c * kChunk]));
         ring_slots = std::bit_ceil(std::max<std::size_t>(reach, 1));
         // The tables hold places in a ring as 32-bit words.
         if ((ring_slots + 1) * sizeof(double) > std::size_t(UINT32_MAX))
             throw CapacityError(fmt::format("the fast variant's canonical sweep needs a ring of {} slots, more than its 32-bit places "
                                             "reach (a particle's partners are {} slots apart in storage)", ring_slots, reach));
-        first_planned_ = false;
-        in_team(parallel, [&] {
-#pragma omp single nowait
-            schedule(list, last_chunk, by_last, last_scratch_);
-            if (thread_count() > 1) {
-#pragma omp single nowait
-                plan_first(list);
-            }
-        });
-    }
-
-    // The downward threads' schedule, once per list (a sweep of two threads or more asks for it).
-    void plan_first(const NeighbourList& list)
-    {
-        if (first_planned_) return;
-        schedule(list, first_chunk, by_first, first_scratch_);
-        first_planned_ = true;
+        schedule(list, last_chunk, by_last, scratch_);
     }
 
     // The sums of up to kGroup particles (grain[0 … count)) from `from`, side by side, each with its
@@ -267,12 +252,11 @@ public:
 
     std::size_t bytes() const
     {
-        return heap_bytes(first_chunk, last_chunk) + last_scratch_.bytes() + first_scratch_.bytes() + by_last.bytes() + by_first.bytes();
+        return heap_bytes(first_chunk, last_chunk) + scratch_.bytes() + by_last.bytes();
     }
 
 private:
-    // One chunk's particles while they are grouped, and the counting sort's places (one per schedule:
-    // the two are planned side by side).
+    // One chunk's particles while they are grouped, and the counting sort's places.
     struct Scratch {
         std::vector<Index> grain, at;
         std::size_t bytes() const { return heap_bytes(grain, at); }
@@ -368,8 +352,7 @@ private:
         }
     }
 
-    Scratch last_scratch_, first_scratch_;
-    bool first_planned_ = false;
+    Scratch scratch_;
 };
 static_assert(sizeof(Slot) == 8 * sizeof(double) && CanonicalSums::kTorqueI + 2 == 8);
 

@@ -4,12 +4,13 @@
 // per-thread ring that stays in cache (slot k at k mod R), not from a list of them all, written to
 // memory and read back every step. A piece of the storage (one per two threads) is swept by two threads,
 // chunk by chunk, one upwards from its start and one downwards from its end, until they meet wherever
-// the machine lets them (neither waits for the other). After each chunk, the upward thread sums the
-// particles whose last slot (as i or as j) was in it, the downward one those whose first was. The others
-// straddle the meeting point or the end of a piece; they are summed after the sweep. Which thread sums a
-// particle, and when, changes no bit of its sum. A chunk's wall contacts are computed with its pairs, so
-// that the sums find their results in cache: every particle summed after chunk c has its own slot in c or
-// before it (upwards; from c on, downwards), and its walls were computed with that chunk.
+// the machine lets them (neither waits for the other). After each chunk c, the upward thread sums the
+// particles of c (their last slot, as i or as j, is in it), the downward one those of c + span (no sum
+// reaches back more than span chunks, so all their slots are in c … c + span, now swept). The others,
+// those of the span chunks above the meeting point and those that reach into the piece before, are
+// summed after the sweep. Which thread sums a particle, and when, changes no bit of its sum. A chunk's
+// wall contacts are computed with its pairs, so that the sums find their results in cache: every
+// particle's walls are computed with its own chunk, swept before its sum.
 #include <atomic>
 #include <cstdint>
 #include <memory>
@@ -44,7 +45,6 @@ public:
         const Index* by_last = sums.by_last.order.data();
         const Index* last_start = sums.by_last.start.data();
         const Index* first_chunk = sums.first_chunk.data();
-        const Index* last_chunk = sums.last_chunk.data();
         const std::size_t chunks = CanonicalSums::chunks(n), span = sums.span_chunks, ring_slots = sums.ring_slots;
         const std::size_t limit = std::size_t(thread_limit());
         if (nclaims_ < limit) {
@@ -63,7 +63,6 @@ public:
             // them waits for it (a barrier costs a system call, and the slower thread's wait).
 #pragma omp single nowait
             {
-                if (nt > 1) sums.plan_first(list);  // the downward threads' schedule
                 cut_pieces(list, pieces, chunks);
                 for (std::size_t q = 0; q < pieces; ++q) claims_[q].reset(piece_chunk_[q], piece_chunk_[q + 1]);
                 if (pieces > 1 && all_.size() < list.pairs()) all_.assign(list.pairs());
@@ -83,15 +82,20 @@ public:
                 const SlotSink sink{in_ring.ring, in_ring.mask, edge ? all_.view() : SlotView{}};
                 my_pp += kernel.template run<true>(std::size_t(pstart[ch * kChunk]), std::size_t(pstart[std::min(n, (ch + 1) * kChunk)]), nullptr, sink);
                 if constexpr (M::walls) my_pw += walls.compute_range<M>(p, law, ch * kChunk, std::min(n, (ch + 1) * kChunk));
-                // The groups of this chunk's schedule; a group with a particle that straddles the end of
-                // the piece (three threads or more) goes a particle at a time, without that one.
+                const CanonicalSums::Schedule& schedule = sums.by_last;
+                if (down) {  // the particles of ch + span, each slot of theirs in ch … ch + span, in this piece
+                    const std::size_t last = ch + span;
+                    if (last < c1)
+                        for (Index q = schedule.group_start[last]; q < schedule.group_start[last + 1]; ++q)
+                            sums.sum_group(schedule, schedule.groups[std::size_t(q)], in_ring.ring, walls, p);
+                    continue;
+                }
+                // The groups of this chunk; a group with a particle that reaches into the piece before
+                // (three threads or more) goes a particle at a time, without that one.
                 const SlotSource from{in_ring.ring, in_ring.ring, in_ring.mask, 0};
-                const CanonicalSums::Schedule& schedule = down ? sums.by_first : sums.by_last;
                 for (Index q = schedule.group_start[ch]; q < schedule.group_start[ch + 1]; ++q) {
                     const CanonicalSums::Group& g = schedule.groups[std::size_t(q)];
-                    auto inside = [&](Index s) {
-                        return down ? std::size_t(last_chunk[s]) < c1 : std::size_t(first_chunk[s]) >= c0;
-                    };
+                    auto inside = [&](Index s) { return std::size_t(first_chunk[s]) >= c0; };
                     bool all = pieces == 1;  // one piece (one or two threads): every sum is inside
                     if (!all) {
                         all = true;
@@ -110,22 +114,22 @@ public:
             }
 #pragma omp barrier
             {
-                // The particles of this piece that straddle its meeting point m (their last chunk is one of
-                // m … m + span): their slots below m are in the upward thread's ring, those from m on in
-                // the downward one's (each holds the last ring_slots it wrote, and no sum reaches over
-                // more). The piece's two threads take half of them each, counted (most lie just above m,
+                // The particles of this piece not yet summed, those of the span chunks from its meeting
+                // point m on (the downward thread summed those above): their slots below m are in the
+                // upward thread's ring, those from m on in the downward one's (each holds the last
+                // ring_slots it wrote, and no sum reaches over more). The piece's two threads take half of them each, counted (most lie just above m,
                 // so a cut by chunk would leave nearly all to one thread), in runs (not every other one:
                 // neighbours in storage share the cache lines of the sums they store), kGroup side by
                 // side. A piece of one thread met at its end.
                 const std::size_t m = claims_[pc].met();
                 const std::size_t up = down ? t - 1 : t, other = !down && t + 1 == nt ? t : up + 1;
                 const SlotSource split{rings_[up].view(), rings_[other].view(), ring_slots - 1, std::size_t(pstart[std::min(n, m * kChunk)])};
-                const std::size_t e1 = std::min(c1, m + span + 1);
+                const std::size_t e1 = std::min(c1, m + span);
                 auto for_each_straddler = [&](auto&& f) {
                     for (std::size_t ch = m; ch < e1; ++ch)
                         for (Index e = last_start[ch]; e < last_start[ch + 1]; ++e) {
-                            const std::size_t s = std::size_t(by_last[e]), first = std::size_t(first_chunk[s]);
-                            if (first >= c0 && first < m) f(s);
+                            const std::size_t s = std::size_t(by_last[e]);
+                            if (std::size_t(first_chunk[s]) >= c0) f(s);  // not those that reach into the piece before
                         }
                 };
                 std::size_t count = 0, at = 0;
