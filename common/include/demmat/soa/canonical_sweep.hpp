@@ -117,10 +117,10 @@ public:
                 // The particles of this piece not yet summed, those of the span chunks from its meeting
                 // point m on (the downward thread summed those above): their slots below m are in the
                 // upward thread's ring, those from m on in the downward one's (each holds the last
-                // ring_slots it wrote, and no sum reaches over more). The piece's two threads take half of them each, counted (most lie just above m,
-                // so a cut by chunk would leave nearly all to one thread), in runs (not every other one:
-                // neighbours in storage share the cache lines of the sums they store), kGroup side by
-                // side. A piece of one thread met at its end.
+                // ring_slots it wrote, and no sum reaches over more). The piece's two threads take half
+                // of them each, counted (a cut by chunk would leave most to one thread), in runs (not
+                // every other one: neighbours in storage share the cache lines of the sums they store),
+                // kGroup side by side. A piece of one thread met at its end.
                 const std::size_t m = claims_[pc].met();
                 const std::size_t up = down ? t - 1 : t, other = !down && t + 1 == nt ? t : up + 1;
                 const SlotSource split{rings_[up].view(), rings_[other].view(), ring_slots - 1, std::size_t(pstart[std::min(n, m * kChunk)])};
