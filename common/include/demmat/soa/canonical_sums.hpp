@@ -108,7 +108,7 @@ public:
         // The tables hold places in a ring as 32-bit words.
         if ((ring_slots + 1) * sizeof(double) > std::size_t(UINT32_MAX))
             throw CapacityError(fmt::format("the fast variant's canonical sweep needs a ring of {} slots, more than its 32-bit places "
-                                            "reach (a particle's partners are {} slots apart in storage)", ring_slots, reach));
+                                            "reach (the {} chunks a sum reaches over hold up to {} slots)", ring_slots, span_chunks + 1, reach));
         schedule(list, last_chunk, by_last, scratch_);
     }
 
