@@ -80,7 +80,10 @@ public:
                 // Slots near the end of a piece are also kept in all_, for the sums that straddle two pieces.
                 const bool edge = (pc > 0 && ch < c0 + span) || (pc + 1 < pieces && ch + span >= c1);
                 const SlotSink sink{in_ring.ring, in_ring.mask, edge ? all_.view() : SlotView{}};
-                my_pp += kernel.template run<true>(std::size_t(pstart[ch * kChunk]), std::size_t(pstart[std::min(n, (ch + 1) * kChunk)]), nullptr, sink);
+                const std::size_t k0 = std::size_t(pstart[ch * kChunk]), k1 = std::size_t(pstart[std::min(n, (ch + 1) * kChunk)]);
+                // The downward thread goes on with the chunk below: the prefetches past this one go there.
+                const std::size_t next = down && ch > c0 ? std::size_t(pstart[(ch - 1) * kChunk]) : k1;
+                my_pp += kernel.template run<true>(k0, k1, nullptr, sink, next);
                 if constexpr (M::walls) my_pw += walls.compute_range<M>(p, law, ch * kChunk, std::min(n, (ch + 1) * kChunk));
                 const CanonicalSums::Schedule& schedule = sums.by_last;
                 if (down) {  // the particles of ch + span, each slot of theirs in ch … ch + span, in this piece

@@ -120,9 +120,12 @@ public:
     // every pair it rejects), so the skin's extra candidates cost a distance, not a pass through the law;
     // the rest go through the law kLanes at a time. The test sorts the slots into kept and dropped
     // without a branch (a third are dropped, in no pattern a predictor learns). Returns the contacts found.
+    // `next`: where this thread's slots go on after k1 (the chunk a downward sweep takes next, below
+    // this one), so that the last kPrefetch slots' prefetches fetch what it reads next; by default k1.
     template <bool Canonical>
-    std::int64_t run(std::size_t k0, std::size_t k1, Load* load, const SlotSink& sink = {}) const
+    std::int64_t run(std::size_t k0, std::size_t k1, Load* load, const SlotSink& sink = {}, std::size_t next = SIZE_MAX) const
     {
+        if (next == SIZE_MAX) next = k1;
         std::size_t kept[kBlock], dropped[kBlock];
         std::int64_t found = 0;
         for (std::size_t c0 = k0; c0 < k1; c0 += kBlock) {
@@ -133,7 +136,8 @@ public:
             // (the remainder one by one).
             for (; k + kLanes <= c1; k += kLanes) {
                 if (prefetch_) {
-                    const std::size_t ahead = std::min(k + kPrefetch, pairs_ - kLanes);
+                    const std::size_t past = k + kPrefetch < k1 ? k + kPrefetch : next + (k + kPrefetch - k1);
+                    const std::size_t ahead = std::min(past, pairs_ - kLanes);
                     for (int l = 0; l < kLanes; ++l) {
                         const Index far = std::max(owner_[ahead + std::size_t(l)], partner_[ahead + std::size_t(l)]);
                         const char* rec = reinterpret_cast<const char*>(&kin_[far]);
