@@ -109,9 +109,15 @@ TEST(CanonicalSums, IndexesAndPlanFollowTheRulesWrittenOut)
 
     CanonicalSums sums;
     sums.plan(list, n, false);
+    std::size_t span = 0;  // the most chunks from a particle's first slot to its last
     for (std::size_t s = 0; s < n; ++s) {
         EXPECT_EQ(sums.first_chunk[s], Index(std::size_t(earliest[s]) / CanonicalSums::kChunk)) << "particle " << s;
-        EXPECT_EQ(sums.last_chunk[s], Index(s / CanonicalSums::kChunk)) << "particle " << s;
+        span = std::max(span, s / CanonicalSums::kChunk - std::size_t(earliest[s]) / CanonicalSums::kChunk);
+    }
+    EXPECT_EQ(sums.span_chunks, span);
+    for (std::size_t c = 0; c < CanonicalSums::chunks(n); ++c) {  // the ring holds any span + 1 chunks' slots
+        const std::size_t end = std::min(n, (c + span + 1) * CanonicalSums::kChunk);
+        EXPECT_LE(std::size_t(list.start[end] - list.start[c * CanonicalSums::kChunk]), sums.ring_slots) << "from chunk " << c;
     }
 
     const int saved = omp_get_max_threads();
@@ -129,6 +135,38 @@ TEST(CanonicalSums, IndexesAndPlanFollowTheRulesWrittenOut)
     EXPECT_EQ(team.jstart, list.jstart);
     EXPECT_EQ(team.as_j, list.as_j);
     EXPECT_EQ(team.earliest, list.earliest);
+}
+
+// Each chunk's groups and tables are planned apart from the others', shared by the team: a plan made
+// on a team of three (repeated, so that the threads meet in every order) is that of one thread.
+TEST(CanonicalSums, PlanOnATeamIsThePlanOfOneThread)
+{
+    std::mt19937_64 rng(778);
+    const std::size_t n = 400 * CanonicalSums::kChunk + 5;
+    std::vector<Index> id;
+    const NeighbourList list = random_list(n, 300, rng, id);
+    CanonicalSums alone;
+    alone.plan(list, n, false);
+    const int saved = omp_get_max_threads();
+    omp_set_num_threads(3);
+    for (int round = 0; round < 3; ++round) {
+        CanonicalSums team;
+        team.plan(list, n, true);
+        EXPECT_EQ(team.first_chunk, alone.first_chunk);
+        EXPECT_EQ(team.span_chunks, alone.span_chunks);
+        EXPECT_EQ(team.ring_slots, alone.ring_slots);
+        EXPECT_EQ(team.by_last.group_start, alone.by_last.group_start);
+        ASSERT_EQ(team.by_last.groups.size(), alone.by_last.groups.size());
+        std::size_t differ = 0;
+        for (std::size_t q = 0; q < alone.by_last.groups.size(); ++q) {
+            const CanonicalSums::Group &a = team.by_last.groups[q], &b = alone.by_last.groups[q];
+            const auto ta = team.by_last.table.begin() + a.table, tb = alone.by_last.table.begin() + b.table;
+            differ += !(std::equal(a.grain, a.grain + CanonicalSums::kGroup, b.grain) && a.count == b.count && a.as_j == b.as_j &&
+                        a.as_i == b.as_i && a.table == b.table && std::equal(ta, ta + (b.as_j + b.as_i) * CanonicalSums::kGroup, tb));
+        }
+        EXPECT_EQ(differ, 0u) << "groups planned otherwise on the team, round " << round;
+    }
+    omp_set_num_threads(saved);
 }
 
 TEST(CanonicalSums, EveryGroupFormGivesEachParticleTheBitsOfItsSumAlone)

@@ -42,27 +42,26 @@ public:
     static constexpr std::size_t kTorqueJ = 0, kForce = 3, kTorqueI = 6;
 
     // A group of sums (sum_group): its particles (-1: none), the longest of their lists as j and as i,
-    // and where its table starts in its schedule's table.
+    // and where its table starts in the schedule's table.
     struct Group {
         Index grain[kGroup] = {};
         std::int32_t count = 0, as_j = 0, as_i = 0;
         std::uint32_t table = 0;
     };
 
-    // The sweep's schedule (by each particle's last chunk): the particles by chunk (order, from
-    // start[chunk]), each chunk's groups (from group_start[chunk]) and their tables of ring places
-    // (schedule(): 8·(k & mask) for slot k, the byte where its t_i.z lies, and an eighth of where its
-    // line does).
+    // The sweep's schedule: each chunk's particles in groups (chunk c's from group_start[c]), and the
+    // groups' tables of ring places (8·(k & mask) for slot k, the byte where its t_i.z lies, and an
+    // eighth of where its line does). A particle is summed with its own chunk, where its last slot is.
     struct Schedule {
-        std::vector<Index> start, order, group_start;
+        std::vector<Index> group_start;
         std::vector<Group> groups;
-        std::vector<std::uint32_t> table;
-        std::size_t bytes() const { return heap_bytes(start, order, group_start, groups, table); }
+        std::vector<std::uint32_t> table;  // at least as long as the groups' tables (it only grows)
+        std::size_t bytes() const { return heap_bytes(group_start, groups, table); }
     };
 
-    // Per particle, the chunks where its first and last slots are stored.
-    std::vector<Index> first_chunk, last_chunk;
-    // The sweep's schedule, by each particle's last chunk (its own).
+    // Per particle, the chunk where its first slot is stored (its last is in its own chunk).
+    std::vector<Index> first_chunk;
+    // The sweep's schedule, by each particle's own chunk.
     Schedule by_last;
     // The most chunks from a particle's first slot to its last (the sweep's span), and a ring of
     // ring_slots slots (a power of two) that holds every slot a sum reads: at least the slots of any
@@ -71,16 +70,25 @@ public:
     std::size_t span_chunks = 0, ring_slots = 1;
 
     static std::size_t chunks(std::size_t n) { return (n + kChunk - 1) / kChunk; }
+    // The particles of chunk c, [begin, end).
+    static std::pair<std::size_t, std::size_t> chunk_range(std::size_t c, std::size_t n) { return {c * kChunk, std::min(n, (c + 1) * kChunk)}; }
 
     // After a canonical list is built: a particle's sum needs the slots of the chunks from the first
     // where one of its slots is stored (the list's earliest) to its own (a slot is stored with the pair's
-    // particle that comes first, so none of a particle's slots lies above it).
+    // particle that comes first, so none of a particle's slots lies above it). Each chunk's groups and
+    // their tables are planned apart from the others', so the team shares them: the groups first, then,
+    // once the tables' lengths are added up and the ring's size known, the tables.
     void plan(const NeighbourList& list, std::size_t n, bool parallel)
     {
         const Index* earliest = list.earliest.data();
         const Index* pstart = list.start.data();
+        const std::size_t nch = chunks(n);
         first_chunk.resize(n);
-        last_chunk.resize(n);
+        by_last.group_start.resize(nch + 1);
+        for (std::size_t c = 0; c <= nch; ++c) by_last.group_start[c] = Index((std::min(n, c * kChunk) + kGroup - 1) / kGroup);
+        by_last.groups.resize(std::size_t(by_last.group_start[nch]));
+        rows_.resize(nch + 1);
+        if (scratch_.size() < std::size_t(thread_limit())) scratch_.resize(std::size_t(thread_limit()));
         // The most chunks from a particle's first chunk to its last.
         std::atomic<std::size_t> most_chunks{0};
         auto raise = [](std::atomic<std::size_t>& to, std::size_t v) {
@@ -89,18 +97,21 @@ public:
         };
         in_team(parallel, [&] {
             std::size_t chunks_here = 0;
+            Scratch& scratch = scratch_[std::size_t(thread_index())];
 #pragma omp for schedule(static) nowait
-            for (std::size_t s = 0; s < n; ++s) {
-                const std::size_t first = std::size_t(earliest[s]) / kChunk, last = s / kChunk;
-                first_chunk[s] = Index(first);
-                last_chunk[s] = Index(last);
-                chunks_here = std::max(chunks_here, last - first);
+            for (std::size_t c = 0; c < nch; ++c) {
+                const auto [b, e] = chunk_range(c, n);
+                for (std::size_t s = b; s < e; ++s) {
+                    const std::size_t first = std::size_t(earliest[s]) / kChunk;
+                    first_chunk[s] = Index(first);
+                    chunks_here = std::max(chunks_here, c - first);
+                }
+                rows_[c + 1] = group(list, c, n, scratch);
             }
             raise(most_chunks, chunks_here);
         });
         span_chunks = most_chunks.load();
         // The most slots in span_chunks + 1 chunks in a row.
-        const std::size_t nch = chunks(n);
         std::size_t reach = 0;
         for (std::size_t c = 0; c < nch; ++c)
             reach = std::max(reach, std::size_t(pstart[std::min(n, (c + span_chunks + 1) * kChunk)] - pstart[c * kChunk]));
@@ -109,7 +120,15 @@ public:
         if ((ring_slots + 1) * sizeof(double) > std::size_t(UINT32_MAX))
             throw CapacityError(fmt::format("the fast variant's canonical sweep needs a ring of {} slots, more than its 32-bit places "
                                             "reach (the {} chunks a sum reaches over hold up to {} slots)", ring_slots, span_chunks + 1, reach));
-        schedule(list, last_chunk, by_last, scratch_);
+        rows_[0] = 0;
+        for (std::size_t c = 0; c < nch; ++c) rows_[c + 1] += rows_[c];
+        if (rows_[nch] > UINT32_MAX)
+            throw CapacityError(fmt::format("the fast variant's canonical sums need {} table entries, more than their 32-bit offsets reach", rows_[nch]));
+        if (by_last.table.size() < rows_[nch]) by_last.table.resize(rows_[nch]);
+        in_team(parallel, [&] {
+#pragma omp for schedule(static)
+            for (std::size_t c = 0; c < nch; ++c) tabulate(list, c);
+        });
     }
 
     // The sums of up to kGroup particles (grain[0 … count)) from `from`, side by side, each with its
@@ -252,11 +271,11 @@ public:
 
     std::size_t bytes() const
     {
-        return heap_bytes(first_chunk, last_chunk) + scratch_.bytes() + by_last.bytes();
+        return heap_bytes(first_chunk, rows_) + scratch_.bytes() + by_last.bytes();
     }
 
 private:
-    // One chunk's particles while they are grouped, and the counting sort's places.
+    // One chunk's particles while they are grouped, and the counting sort's places (a thread's own).
     struct Scratch {
         std::vector<Index> grain, at;
         std::size_t bytes() const { return heap_bytes(grain, at); }
@@ -281,20 +300,52 @@ private:
         tq += Quad{line[kTorqueI], line[kTorqueI + 1], tz, 0.0};
     }
 
-    // The schedule of the particles by chunk[s]: each chunk's particles (order[start[c] … start[c + 1]),
-    // sorted by their counts of slots as j and as i, so that a group's lists are near one length),
-    // kGroup particles a group, and their tables: a row of ring places a step, the lists as j to the
-    // group's longest, then as i, padded with the place of the ring's slot of zeros (ring_slots).
-    void schedule(const NeighbourList& list, const std::vector<Index>& chunk, Schedule& out, Scratch& scratch) const
+    // Chunk c's particles in groups of kGroup (by_last.groups from group_start[c]), each group with its
+    // particles and the longest of their lists as j and as i; returns the length of the chunk's tables.
+    // The particles by count as j, and within a count by count as i, ascending for an even count as j
+    // and descending for an odd one: a group that straddles two counts as j then takes its lists as i
+    // from the same end of both, so that fewer are padded (the groups' rows are the longest list of
+    // each kind). A stable counting sort by that key, of the chunk's particles in storage order.
+    std::size_t group(const NeighbourList& list, std::size_t c, std::size_t n, Scratch& scratch)
     {
-        const std::size_t nch = chunks(chunk.size());
-        bucket_sort(chunk, nch, out.start, out.order);
-        const std::vector<Index>& order = out.order;
-        const std::vector<Index>& start = out.start;
-        std::vector<Index>& group_start = out.group_start;
-        std::vector<Group>& groups = out.groups;
-        std::vector<std::uint32_t>& table = out.table;
-        table.clear();
+        const Index* jstart = list.jstart.data();
+        const Index* istart = list.istart.data();
+        const auto [b, e] = chunk_range(c, n);
+        const std::size_t size = e - b;
+        std::size_t most_i = 0;
+        for (std::size_t s = b; s < e; ++s) most_i = std::max(most_i, std::size_t(istart[s + 1] - istart[s]));
+        auto key_of = [&](std::size_t s) {
+            const std::size_t j = std::size_t(jstart[s + 1] - jstart[s]), i = std::size_t(istart[s + 1] - istart[s]);
+            return j * (most_i + 1) + (j % 2 == 0 ? i : most_i - i);
+        };
+        std::size_t most = 0;
+        for (std::size_t s = b; s < e; ++s) most = std::max(most, key_of(s));
+        scratch.at.assign(most + 2, 0);
+        for (std::size_t s = b; s < e; ++s) ++scratch.at[key_of(s) + 1];
+        for (std::size_t k = 0; k <= most; ++k) scratch.at[k + 1] += scratch.at[k];
+        scratch.grain.resize(size);
+        for (std::size_t s = b; s < e; ++s) scratch.grain[std::size_t(scratch.at[key_of(s)]++)] = Index(s);
+        Group* g = by_last.groups.data() + by_last.group_start[c];
+        std::size_t rows = 0;
+        for (std::size_t g0 = 0; g0 < size; g0 += kGroup, ++g) {
+            *g = Group{};
+            g->count = std::int32_t(std::min<std::size_t>(kGroup, size - g0));
+            for (int l = 0; l < kGroup; ++l) {
+                const Index s = l < g->count ? scratch.grain[g0 + std::size_t(l)] : -1;
+                g->grain[l] = s;
+                if (s < 0) continue;
+                g->as_j = std::max(g->as_j, jstart[s + 1] - jstart[s]);
+                g->as_i = std::max(g->as_i, istart[s + 1] - istart[s]);
+            }
+            rows += std::size_t(g->as_j + g->as_i) * kGroup;
+        }
+        return rows;
+    }
+
+    // Chunk c's groups' tables, from rows_[c] on: a row of ring places a step, the lists as j to the
+    // group's longest, then as i, padded with the place of the ring's slot of zeros (ring_slots).
+    void tabulate(const NeighbourList& list, std::size_t c)
+    {
         const Index* jstart = list.jstart.data();
         const Index* as_j = list.as_j.data();
         const Index* istart = list.istart.data();
@@ -302,57 +353,25 @@ private:
         const std::size_t mask = ring_slots - 1;
         auto place = [mask](Index k) { return std::uint32_t((std::size_t(k) & mask) * sizeof(double)); };
         const std::uint32_t zeros = std::uint32_t(ring_slots * sizeof(double));
-        group_start.assign(nch + 1, 0);
-        groups.clear();
-        for (std::size_t c = 0; c < nch; ++c) {
-            // The chunk's particles by count as j, and within a count by count as i, ascending for an
-            // even count as j and descending for an odd one: a group that straddles two counts as j
-            // then takes its lists as i from the same end of both, so that fewer are padded (the
-            // groups' rows are the longest list of each kind). A stable counting sort by that key of
-            // the chunk's particles, which order holds by storage index.
-            const Index* const in = order.data() + start[c];
-            const std::size_t size = std::size_t(start[c + 1] - start[c]);
-            std::size_t most_i = 0;
-            for (std::size_t e = 0; e < size; ++e) most_i = std::max(most_i, std::size_t(istart[in[e] + 1] - istart[in[e]]));
-            auto key_of = [&](Index s) {
-                const std::size_t j = std::size_t(jstart[s + 1] - jstart[s]), i = std::size_t(istart[s + 1] - istart[s]);
-                return j * (most_i + 1) + (j % 2 == 0 ? i : most_i - i);
-            };
-            std::size_t most = 0;
-            for (std::size_t e = 0; e < size; ++e) most = std::max(most, key_of(in[e]));
-            scratch.at.assign(most + 2, 0);
-            for (std::size_t e = 0; e < size; ++e) ++scratch.at[key_of(in[e]) + 1];
-            for (std::size_t k = 0; k <= most; ++k) scratch.at[k + 1] += scratch.at[k];
-            scratch.grain.resize(size);
-            for (std::size_t e = 0; e < size; ++e) scratch.grain[std::size_t(scratch.at[key_of(in[e])]++)] = in[e];
-            for (std::size_t g0 = 0; g0 < size; g0 += kGroup) {
-                Group g;
-                g.count = std::int32_t(std::min<std::size_t>(kGroup, size - g0));
-                g.table = std::uint32_t(table.size());
-                for (int l = 0; l < kGroup; ++l) {
-                    const Index s = l < g.count ? scratch.grain[g0 + std::size_t(l)] : -1;
-                    g.grain[l] = s;
-                    if (s < 0) continue;
-                    g.as_j = std::max(g.as_j, jstart[s + 1] - jstart[s]);
-                    g.as_i = std::max(g.as_i, istart[s + 1] - istart[s]);
-                }
-                // The group's rows, the slot of zeros wherever a list has ended, then each list down its column.
-                table.resize(table.size() + std::size_t(g.as_j + g.as_i) * kGroup, zeros);
-                std::uint32_t* rows = table.data() + g.table;
-                for (int l = 0; l < g.count; ++l) {
-                    const Index s = g.grain[l];
-                    for (Index e = 0; e < jstart[s + 1] - jstart[s]; ++e)
-                        rows[std::size_t(e) * kGroup + std::size_t(l)] = place(as_j[jstart[s] + e]);
-                    for (Index e = 0; e < istart[s + 1] - istart[s]; ++e)
-                        rows[std::size_t(g.as_j + e) * kGroup + std::size_t(l)] = place(as_i[istart[s] + e]);
-                }
-                groups.push_back(g);
+        std::size_t at = rows_[c];
+        for (Index q = by_last.group_start[c]; q < by_last.group_start[c + 1]; ++q) {
+            Group& g = by_last.groups[std::size_t(q)];
+            g.table = std::uint32_t(at);
+            std::uint32_t* rows = by_last.table.data() + at;
+            at += std::size_t(g.as_j + g.as_i) * kGroup;
+            // The slot of zeros wherever a list has ended, then each list down its column.
+            std::fill(rows, by_last.table.data() + at, zeros);
+            for (int l = 0; l < g.count; ++l) {
+                const Index s = g.grain[l];
+                for (Index e = 0; e < jstart[s + 1] - jstart[s]; ++e) rows[std::size_t(e) * kGroup + std::size_t(l)] = place(as_j[jstart[s] + e]);
+                for (Index e = 0; e < istart[s + 1] - istart[s]; ++e)
+                    rows[std::size_t(g.as_j + e) * kGroup + std::size_t(l)] = place(as_i[istart[s] + e]);
             }
-            group_start[c + 1] = Index(groups.size());
         }
     }
 
-    Scratch scratch_;
+    PerThread<Scratch> scratch_;
+    std::vector<std::size_t> rows_;  // per chunk, where its groups' tables start (plan())
 };
 static_assert(sizeof(Slot) == 8 * sizeof(double) && CanonicalSums::kTorqueI + 2 == 8);
 

@@ -42,8 +42,6 @@ public:
         std::atomic<std::int64_t> pp{0}, pw{0};
         std::size_t team = 1;
         const Index* pstart = list.start.data();
-        const Index* by_last = sums.by_last.order.data();
-        const Index* last_start = sums.by_last.start.data();
         const Index* first_chunk = sums.first_chunk.data();
         const std::size_t chunks = CanonicalSums::chunks(n), span = sums.span_chunks, ring_slots = sums.ring_slots;
         const std::size_t limit = std::size_t(thread_limit());
@@ -129,11 +127,8 @@ public:
                 const SlotSource split{rings_[up].view(), rings_[other].view(), ring_slots - 1, std::size_t(pstart[std::min(n, m * kChunk)])};
                 const std::size_t e1 = std::min(c1, m + span);
                 auto for_each_straddler = [&](auto&& f) {
-                    for (std::size_t ch = m; ch < e1; ++ch)
-                        for (Index e = last_start[ch]; e < last_start[ch + 1]; ++e) {
-                            const std::size_t s = std::size_t(by_last[e]);
-                            if (std::size_t(first_chunk[s]) >= c0) f(s);  // not those that reach into the piece before
-                        }
+                    for (std::size_t s = m * kChunk; s < std::min(n, e1 * kChunk); ++s)
+                        if (std::size_t(first_chunk[s]) >= c0) f(s);  // not those that reach into the piece before
                 };
                 std::size_t count = 0, at = 0;
                 for_each_straddler([&](std::size_t) { ++count; });
@@ -149,11 +144,10 @@ public:
                 const SlotSource everything{all_.view(), all_.view(), ~std::size_t(0), 0};
                 const std::size_t b0 = piece_chunk_[pc - 1];
                 Batch batch(sums, everything, list, walls, p);
-                for (std::size_t ch = c0; ch < std::min(chunks, c0 + span + 1); ++ch)
-                    for (Index e = last_start[ch]; e < last_start[ch + 1]; ++e) {
-                        const std::size_t s = std::size_t(by_last[e]), f = std::size_t(first_chunk[s]);
-                        if (f >= b0 && f < c0) batch.add(s);
-                    }
+                for (std::size_t s = c0 * kChunk; s < std::min(n, (c0 + span + 1) * kChunk); ++s) {
+                    const std::size_t f = std::size_t(first_chunk[s]);
+                    if (f >= b0 && f < c0) batch.add(s);
+                }
             }
             pp += my_pp;
             pw += my_pw;
