@@ -6,19 +6,21 @@
 # that it fits (peak memory from /usr/bin/time).
 # Writes results/fast/bench_settled_<N>.json and bench_loose_1000000.json (+ .txt; every thread count,
 # interleaved), results/fast/million.txt and the table
-# results/fast/summary.md (analysis/summarise_fast.py: the tables, and what the canonical order costs, paired).
+# results/fast/summary.md (analysis/summarise_fast.py: the tables, and what the canonical order costs, paired);
+# --out DIR writes them in DIR instead (a second machine's run beside the first).
 # Timed steps per repetition are 5·10^6/N (at least 20), so each sample is ~10^6–10^7 particle-steps.
 # Usage: scripts/bench_fast.sh [--sizes "1000 10000 100000"] [--threads "1 2"] [--repetitions R]
-#                              [--settle-time T] [--no-million] [--settle-only] [--build-dir DIR]
+#                              [--settle-time T] [--no-million] [--settle-only] [--out DIR] [--build-dir DIR]
 #   --sizes LIST     the bed sizes N (default "1000 10000 100000")
 #   --threads LIST   the thread counts, timed interleaved (default "1 2")
 #   --repetitions R  interleaved repetitions (default 5)
 #   --settle-time T  simulated seconds of settling (default 0.4)
 #   --no-million     without the loose lattice of 10^6
 #   --settle-only    settle the beds (the slow, once-only part) and stop
+#   --out DIR        the results in DIR (default results/fast)
 #   --build-dir DIR  the build folder (default build, or $DEMMAT_BUILD_DIR)
 source "$(dirname "$0")/lib.sh"
-sizes="1000 10000 100000"; threads="1 2"; reps=5; settle=0.4; million=1; settle_only=0
+sizes="1000 10000 100000"; threads="1 2"; reps=5; settle=0.4; million=1; settle_only=0; outdir=results/fast
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --sizes) need_value "$@"; sizes=$2; shift 2 ;;
@@ -27,6 +29,7 @@ while [[ $# -gt 0 ]]; do
     --settle-time) need_value "$@"; settle=$2; shift 2 ;;
     --no-million) million=0; shift ;;
     --settle-only) settle_only=1; million=0; shift ;;
+    --out) need_value "$@"; outdir=$2; shift 2 ;;
     *) shared_option "$@"; shift "$SHIFT" ;;
   esac
 done
@@ -36,7 +39,7 @@ positive_int --repetitions "$reps"
 install_deps
 cmake_build "$BUILD_DIR" demmat
 demmat=$(demmat_in "$BUILD_DIR")
-mkdir -p scenes/generated states results/fast
+mkdir -p scenes/generated states "$outdir"
 
 for n in $sizes; do
   bed=scenes/generated/dense_bed_${n}.toml
@@ -48,7 +51,7 @@ for n in $sizes; do
   rm -f "$bed.new"
   if [[ ! -f "$state" ]]; then
     echo "== settling the dense bed of $n particles ($settle s simulated, fast on every core; done once)"
-    $demmat run "$bed" --variant fast --time "$settle" --save "$state" -q --json results/fast/settle_${n}.json
+    $demmat run "$bed" --variant fast --time "$settle" --save "$state" -q --json "$outdir"/settle_${n}.json
   fi
   [[ $settle_only == 1 ]] && continue
   # The settled bed continuing from its state, walls at rest (demmat scene settled).
@@ -57,7 +60,7 @@ for n in $sizes; do
   # Every thread count in one run, interleaved with the variants, so that the speed-up compares samples
   # taken side by side (separate runs met different moods of the shared machine).
   echo "== N = $n, threads ${threads// /,}: $reps interleaved repetitions of $steps steps"
-  out=results/fast/bench_settled_${n}
+  out="$outdir"/bench_settled_${n}
   rm -f "$out"_t*.json "$out"_t*.txt  # the earlier layout, one run per thread count
   $demmat bench "$settled" --variants arrays,fast,fast_unordered --steps "$steps" --warmup 10 \
     --repetitions "$reps" --threads "${threads// /,}" --json "$out.json" | tee "$out.txt"
@@ -70,14 +73,14 @@ if [[ $million == 1 ]]; then
   # The loose lattice of 10^6 (settling it would take hours): every variant and thread count, interleaved.
   echo "== N = 1000000 (loose lattice), threads ${threads// /,}: 3 interleaved repetitions of 10 steps"
   $demmat bench "$big" --variants arrays,fast,fast_unordered --steps 10 --warmup 2 --repetitions 3 \
-    --threads "${threads// /,}" --json results/fast/bench_loose_1000000.json | tee results/fast/bench_loose_1000000.txt
+    --threads "${threads// /,}" --json "$outdir"/bench_loose_1000000.json | tee "$outdir"/bench_loose_1000000.txt
   echo "== 10^6 particles: 20 steps of fast from the loose lattice (memory and time)"
-  /usr/bin/time -v $demmat run "$big" --variant fast --steps 20 -q --json results/fast/million.json \
-    > results/fast/million.txt 2> results/fast/million_time.txt
+  /usr/bin/time -v $demmat run "$big" --variant fast --steps 20 -q --json "$outdir"/million.json \
+    > "$outdir"/million.txt 2> "$outdir"/million_time.txt
   # time names the command as run: the binary's path on this machine, made relative to the checkout.
-  sed -i "s|$PWD/||g" results/fast/million_time.txt
-  grep -E "Maximum resident|Elapsed" results/fast/million_time.txt | tee -a results/fast/million.txt
-  cat results/fast/million.txt
+  sed -i "s|$PWD/||g" "$outdir"/million_time.txt
+  grep -E "Maximum resident|Elapsed" "$outdir"/million_time.txt | tee -a "$outdir"/million.txt
+  cat "$outdir"/million.txt
 fi
-$PYTHON analysis/summarise_fast.py results/fast -o results/fast/summary.md >/dev/null
-echo "results in results/fast/ (table: results/fast/summary.md)"
+$PYTHON analysis/summarise_fast.py "$outdir" -o "$outdir"/summary.md >/dev/null
+echo "results in $outdir/ (table: $outdir/summary.md)"
