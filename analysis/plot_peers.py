@@ -111,6 +111,22 @@ def paired_ratios(df):
         g.max().rename("paired_max")).reset_index()
 
 
+def timed_steps(df, stage, n):
+    """The timed steps of one stage at one N, as a table cell: one number when every run had the same."""
+    k = sorted(df[(df.stage == stage) & (df.particles == n)].steps.unique())
+    return "/".join(str(int(v)) for v in k)
+
+
+def steps_note(df):
+    """What the tables' last rows, the timed steps, mean for reading one N beside another."""
+    if df.groupby("particles").steps.max().nunique() > 1:
+        return ("The codes run the same timed steps at each N (each table's last row), more at a small N: on a stage "
+                "that changes as it runs (the loose grid falls and its grains collide, the compression stage is "
+                "squeezed), each N covers a different stretch of it, so one N's ratios are read beside another's "
+                "with that in mind (docs/peers.md, the loose grid).")
+    return "Every code runs the same timed steps at every N (each table's last row)."
+
+
 def write_bench(df, provenance, versions, out, figure):
     """Medians, ratios to LAMMPS, bench_peers.{csv,json,md} in out, and the figure, from every sample."""
     if df.empty:
@@ -168,6 +184,7 @@ def write_bench(df, provenance, versions, out, figure):
              + f"suite commit {(provenance or {}).get('commit', '?')}, {(provenance or {}).get('compiler', '?')}, "
              f"CPU {cpu}. Ratio < 1: faster than LAMMPS. Per stage, the ratio of the medians, then the paired ratios. "
              f"Produced by scripts/run_peers.sh; every sample in bench_peers.json.", "",
+             steps_note(df), "",
              f"Contact law: {versions.get('contact_law', 'the paper' + chr(39) + 's (physics.md section 2)')}.", ""]
     ns = sorted(med.particles.unique())
     for stage in STAGES:
@@ -184,6 +201,7 @@ def write_bench(df, provenance, versions, out, figure):
             lines.append(f"| {v} | " + " | ".join(cells) + " |")
         lam_row = [m[(m.variant == 'lammps') & (m.particles == n)]["median"] for n in ns]
         lines.append("| *LAMMPS µs per particle-step* | " + " | ".join("" if r.empty else f"{r.iloc[0]:.3f}" for r in lam_row) + " |")
+        lines.append("| *timed steps* | " + " | ".join(timed_steps(df, stage, n) for n in ns) + " |")
         lines += ["", "Paired: each repetition's own ratio (the code and LAMMPS run side by side), median (min–max).", "",
                   "| code | " + " | ".join(f"N = {n}" for n in ns) + " |",
                   "|---|" + "---:|" * len(ns)]

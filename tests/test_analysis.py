@@ -300,6 +300,31 @@ class PeersBench(unittest.TestCase):
         row = [r for r in summary if r["variant"] == "fast"][0]
         self.assertAlmostEqual(row["paired_ratio"], 1 / 3, places=12)
 
+    def test_the_timed_steps_of_each_n_are_in_the_table_and_a_varying_count_is_named(self):
+        import pandas as pd
+
+        def table(steps_of):
+            rows = []
+            for n, k in steps_of.items():
+                for code in ("suite", "lammps"):
+                    rows.append({"code": code, "variant": "fast" if code == "suite" else code, "particles": n, "stage": "loose",
+                                 "repetition": 0, "steps": k, "phase": "total", "seconds_per_step": 1e-4})
+            self.peers.write_bench(pd.DataFrame(rows), {}, {"lammps": "test"}, self.work, os.path.join(self.work, "f.png"))
+            with open(os.path.join(self.work, "bench_peers.md")) as f:
+                return f.read().split("## ")[1]  # the loose grid's table
+
+        text = table({1000: 1000, 4000: 250})
+        row = [line for line in text.splitlines() if line.startswith("| *timed steps*")]
+        self.assertEqual(row, ["| *timed steps* | 1000 | 250 |"])
+        with open(os.path.join(self.work, "bench_peers.md")) as f:
+            self.assertIn("more at a small N", f.read())
+        text = table({1000: 200, 4000: 200})
+        self.assertIn("| *timed steps* | 200 | 200 |", text)
+        with open(os.path.join(self.work, "bench_peers.md")) as f:
+            whole = f.read()
+        self.assertIn("the same timed steps at every N", whole)
+        self.assertNotIn("more at a small N", whole)
+
 
 class PeerContacts(unittest.TestCase):
     """peer_contacts.py: the four-grain scene keeps the stage's law and walls and sets each contact up as
