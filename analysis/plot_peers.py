@@ -119,12 +119,12 @@ def timed_steps(df, stage, n):
 
 def steps_note(df):
     """What the tables' last rows, the timed steps, mean for reading one N beside another."""
-    if df.groupby("particles").steps.max().nunique() > 1:
-        return ("The codes run the same timed steps at each N (each table's last row), more at a small N: on a stage "
-                "that changes as it runs (the loose grid falls and its grains collide, the compression stage is "
-                "squeezed), each N covers a different stretch of it, so one N's ratios are read beside another's "
-                "with that in mind (docs/peers.md, the loose grid).")
-    return "Every code runs the same timed steps at every N (each table's last row)."
+    if df.steps.nunique() == 1:
+        return "Every code runs the same timed steps at every N (each table's last row)."
+    return ("The timed steps differ from one N to another (each table's last row): on a stage that changes as it "
+            "runs (the loose grid falls and its grains collide, the compression stage is squeezed), each N covers a "
+            "different stretch of it, so one N's ratios are read beside another's with that in mind (docs/peers.md, "
+            "the loose grid).")
 
 
 def write_bench(df, provenance, versions, out, figure):
