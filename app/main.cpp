@@ -54,9 +54,12 @@ std::unique_ptr<Problem> load(const std::string& file, bool allow_unstable, cons
     Scene scene = load_scene(file);
     if (prepare) prepare(scene);
     auto l = std::make_unique<Problem>(std::move(scene));
+    if (const std::string w = check_continued_walls(l->scene(), l->state()); !w.empty()) std::cerr << "demmat: warning: " << w << "\n";
     if (!allow_unstable) {
         const std::string warning = check_time_step(l->scene(), l->state());
         if (!warning.empty()) std::cerr << "demmat: warning: " << warning << "\n";
+    } else {
+        check_magnitudes(l->scene(), l->state());  // what no run survives, --allow-unstable or not
     }
     return l;
 }
@@ -338,6 +341,8 @@ std::vector<int> thread_counts(const std::string& spec)
 {
     const int fallback = max_threads();
     std::vector<int> out;
+    if (spec.empty() || spec.front() == ',' || spec.back() == ',' || spec.find(",,") != std::string::npos)
+        throw Error(fmt::format("--threads '{}': an empty item in the list (thread counts separated by single commas)", spec));
     for (const std::string& item : split_list(spec)) {
         std::size_t used = 0;
         int t = -1;
@@ -479,19 +484,55 @@ struct SceneArgs {
     std::vector<std::string> contact;  // --contact KEY=VALUE: the [contact] table (physics.md §9)
     ChungOoiCase chung_ooi = no_test();  // chung-ooi (test 0: --test not given): --test, --material, --value, --law, --per-tc
     bool chung_ooi_value = false;      // --value given (else the test's first)
+    std::vector<std::string> given;    // the options given, by their long names
 };
+
+// The options each kind of scene reads (besides --out): any other option given is refused, never ignored.
+void check_scene_options(const SceneArgs& a)
+{
+    static const std::map<std::string, std::vector<std::string>> takes = {
+        {"paper", {"--n", "--seed", "--contact"}},
+        {"dense-bed", {"--n", "--seed", "--max-layers", "--contact"}},
+        {"head-on", {"--speed", "--contact"}},
+        {"drop", {"--gap", "--contact"}},
+        {"chung-ooi", {"--test", "--material", "--value", "--law", "--per-tc"}},
+        {"compression", {"--from", "--state", "--speed", "--contact"}},
+        {"settled", {"--from", "--state", "--contact"}}};
+    const auto it = takes.find(a.kind);
+    if (it == takes.end()) return;  // an unknown kind is named by cmd_scene
+    for (const std::string& opt : a.given)
+        if (opt != "--out" && std::find(it->second.begin(), it->second.end(), opt) == it->second.end())
+            throw Error(fmt::format("scene {} does not use {} (it takes {} and --out)", a.kind, opt, fmt::join(it->second, ", ")));
+    if (a.kind == "chung-ooi" && a.chung_ooi_value && a.chung_ooi.test >= 1 && a.chung_ooi.test <= 8 &&
+        chung_ooi_test(a.chung_ooi.test).sweep == ChungOoiSweep::none)
+        throw Error(fmt::format("scene chung-ooi --test {} sweeps nothing: --value has no meaning for it", a.chung_ooi.test));
+}
+
+// Checking a scene makes its grains (the state and the t = 0 force pass, about this many bytes each):
+// a count this machine cannot hold is refused at once rather than by the out-of-memory killer.
+constexpr double kBytesPerGrainToCheck = 384.0;
+void check_memory_for(std::int64_t grains)
+{
+    const double need = double(grains) * kBytesPerGrainToCheck;
+    const double have = double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGE_SIZE));
+    if (have > 0.0 && need > have)
+        throw Error(fmt::format("--n {}: checking the scene makes its grains, about {:.0f} GB at {:.0f} bytes a grain, more than this "
+                                "machine's {:.0f} GB of memory", grains, need / 1e9, kBytesPerGrainToCheck, have / 1e9));
+}
 
 // Writes a scene only if `demmat run` would accept it: the options are checked by their validators (--n
 // >= 1, --speed > 0, --gap >= 0, finite), and the scene itself by making its initial state (particles in
 // the domain, apart, clear of the walls; a state file of this scene) and checking Δt as run does.
 int cmd_scene(const SceneArgs& a)
 {
+    check_scene_options(a);
     if (!a.out.empty() && !to_stdout(a.out)) {
         std::vector<NamedPath> inputs;
         if (!a.from.empty()) inputs.emplace_back(a.from, "scene file");
         if (!a.state.empty()) inputs.emplace_back(a.state, "state file");
         check_output_path(a.out, "--out", inputs);
     }
+    if ((a.kind == "paper" || a.kind == "dense-bed") && a.count > 0) check_memory_for(a.count);
     Scene s;
     if (a.kind == "paper") s = paper_scene(a.count > 0 ? a.count : 1000, a.seed);
     else if (a.kind == "dense-bed") s = dense_bed_scene(a.count > 0 ? a.count : 2000, a.seed, a.max_layers);
@@ -504,12 +545,18 @@ int cmd_scene(const SceneArgs& a)
         if (!a.chung_ooi_value) c.value = chung_ooi_test(c.test).values.front();
         s = chung_ooi_scene(c);
     }
-    else if (a.kind == "compression") {
-        if (a.from.empty() || a.state.empty()) throw Error("scene compression needs --from SCENE and --state STATE");
-        s = compression_scene(load_scene(a.from), a.state, a.speed > 0.0 ? a.speed : 0.5);
-    } else if (a.kind == "settled") {
-        if (a.from.empty() || a.state.empty()) throw Error("scene settled needs --from SCENE and --state STATE");
-        s = settled_scene(load_scene(a.from), a.state);
+    else if (a.kind == "compression" || a.kind == "settled") {
+        if (a.from.empty() || a.state.empty()) throw Error(fmt::format("scene {} needs --from SCENE and --state STATE", a.kind));
+        const Scene from = load_scene(a.from);
+        // The state must hold the grains of the scene it continues (the fingerprint binds its materials,
+        // Δt and gravity to its own count, so a state of 2000 grains would pass for a scene of 1).
+        const std::size_t from_count = from.grid ? std::size_t(from.grid->count)
+                                     : from.state_file.empty() ? from.particles.size() : load_state(from.state_file).size();
+        const std::size_t state_count = load_state(a.state).size();
+        if (from_count != state_count)
+            throw Error(fmt::format("--state {} holds {} particles, but --from {} makes {}: the state was not saved from this scene",
+                                    a.state, state_count, a.from, from_count));
+        s = a.kind == "compression" ? compression_scene(from, a.state, a.speed > 0.0 ? a.speed : 0.5) : settled_scene(from, a.state);
     } else {
         throw Error(fmt::format("unknown scene kind '{}' (expected paper, dense-bed, settled, compression, head-on, drop or chung-ooi)", a.kind));
     }
@@ -517,6 +564,12 @@ int cmd_scene(const SceneArgs& a)
     {
         const State state = initial_state(s);
         check_time_step(s, state);  // throws above the stability limit; its warnings are run's to give
+        // A continued scene names its walls where the state has them, so that the file says what a run does.
+        if (!s.state_file.empty())
+            for (std::size_t w = 0; w < s.walls.size(); ++w) {
+                s.walls[w].point = state.walls[w].point_at(state.step, s.dt);
+                s.walls[w].normal = state.walls[w].normal;
+            }
     }
     if ((a.kind == "compression" || a.kind == "settled") && !a.out.empty() && !to_stdout(a.out)) {  // the state path relative to the new scene file, so the pair can move together
         std::error_code ec;
@@ -550,7 +603,8 @@ int main(int argc, char** argv)
     scene->add_option("kind", sa.kind, "paper | dense-bed | settled | compression | head-on | drop | chung-ooi")->required();
     scene->add_option("--out,-o", sa.out, "Output file (default, or -: standard output)")->check(path_given());
     constexpr std::int64_t int_max = 2147483647, int64_max = std::numeric_limits<std::int64_t>::max();
-    scene->add_option("--n", sa.count, "Number of particles (paper: 1000, dense-bed: 2000)")
+    scene->add_option("--n", sa.count, "Number of particles (paper: 1000, dense-bed: 2000; at most what this machine's memory holds, "
+                                       "about 384 bytes a grain)")
         ->check(integer_in(1, int_max, "32-bit particle indices"));
     scene->add_option("--seed", sa.seed, "Seed of the particle generator")->check(integer_in(0, int64_max));
     scene->add_option("--max-layers", sa.max_layers, "dense-bed: at most this many lattice layers; more grains make the bed wider")
@@ -617,6 +671,12 @@ int main(int argc, char** argv)
                       "Comma-separated thread counts for the threaded variants, timed interleaved (e.g. 1,2); 0: OpenMP's default");
 
     remove_partial_files_on_signal();
+    std::vector<std::string> names;
+    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) names.push_back(sub->get_name());
+    if (argc > 1 && argv[1][0] != '-' && std::find(names.begin(), names.end(), argv[1]) == names.end()) {  // CLI11: "A subcommand is required"
+        std::cerr << fmt::format("demmat: error: unknown subcommand '{}' (expected {}; see demmat --help)\n", argv[1], fmt::join(names, ", "));
+        return 2;
+    }
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -630,6 +690,8 @@ int main(int argc, char** argv)
         return 2;
     }
     set_threads(threads);
+    for (const CLI::Option* opt : scene->get_options())
+        if (opt->count() > 0 && opt->nonpositional()) sa.given.push_back(opt->get_name());
 
     try {
         if (*list) {

@@ -1,5 +1,7 @@
 #include "peer_commands.hpp"
 
+#include <algorithm>
+
 #include <iostream>
 #include <limits>
 
@@ -93,7 +95,17 @@ int cmd_export(const std::string& scene_file, const std::string& state_file, con
         check_output_path(data.parent_path() / (data.stem().string() + ext), "--out", inputs);
     check_output_path(data, "--out", inputs);
     State state = initial_state(scene);
-    if (perturb > 0.0) perturb_velocities(state, perturb, seed);
+    const Vec3d side = scene.domain.max - scene.domain.min;
+    if (skin > std::max({side.x, side.y, side.z}))
+        throw Error(fmt::format("--skin {:g} m is larger than the domain itself (its largest side is {:g} m)", skin, std::max({side.x, side.y, side.z})));
+    if (perturb > 0.0) {
+        perturb_velocities(state, perturb, seed);
+        try {  // the perturbed grains must still make a run the time-step check accepts
+            check_time_step(scene, state);
+        } catch (const Error& e) {
+            throw Error(fmt::format("--perturb {:g} m/s: the perturbed velocities fail the time-step check: {}", perturb, e.what()));
+        }
+    }
     PeerOptions o;
     o.data_name = data.filename().string();
     o.mesh_prefix = data.stem().string();
@@ -130,6 +142,8 @@ int cmd_dump(const std::string& scene_file, const std::string& state_file, const
     if (!allow_unstable) {  // the time step against the chosen integrator's limit, as run checks it
         const std::string warning = check_time_step(scene, state);
         if (!warning.empty()) std::cerr << "demmat: warning: " << warning << "\n";
+    } else {
+        check_magnitudes(scene, state);
     }
     const Setup setup = Setup::make(scene, state);
     auto variant = registry().find(variant_name).create();
