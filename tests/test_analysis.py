@@ -465,6 +465,40 @@ class Report(unittest.TestCase):
             shutil.rmtree(root)
 
 
+class Experiments(unittest.TestCase):
+    """results/experiments/README.md is the table of the records beside it, and a record is checked."""
+    FOLDER = os.path.join(HERE, os.pardir, "results", "experiments")
+
+    def test_the_committed_table_is_generated_from_the_records(self):
+        import experiments_table
+        records = experiments_table.load(self.FOLDER)
+        self.assertGreater(len(records), 30)
+        with open(os.path.join(self.FOLDER, "README.md"), encoding="utf-8") as f:
+            self.assertEqual(f.read(), experiments_table.render(records))
+        self.assertEqual(subprocess.run([sys.executable, os.path.join(ANALYSIS, "experiments_table.py"), "--check",
+                                         "--folder", self.FOLDER]).returncode, 0)
+
+    def test_a_changed_record_changes_the_table_and_a_bad_one_is_refused(self):
+        import experiments_table
+        with tempfile.TemporaryDirectory() as d:
+            for name in os.listdir(self.FOLDER):
+                shutil.copy(os.path.join(self.FOLDER, name), d)
+            path = os.path.join(d, "law-on-16-lanes.json")
+            with open(path) as f:
+                rec = json.load(f)
+            rec["readings"][0]["ratio"] = 9.875
+            with open(path, "w") as f:
+                json.dump(rec, f)
+            self.assertIn("forces 9.875 (1.744–2.707)", experiments_table.render(experiments_table.load(d)))
+            check = [sys.executable, os.path.join(ANALYSIS, "experiments_table.py"), "--check", "--folder", d]
+            self.assertEqual(subprocess.run(check, stderr=subprocess.DEVNULL).returncode, 1)
+            del rec["cpu"]
+            with open(path, "w") as f:
+                json.dump(rec, f)
+            with self.assertRaisesRegex(ValueError, "missing cpu"):
+                experiments_table.load(d)
+
+
 class ValidationReference(unittest.TestCase):
     """The Chung & Ooi references (analysis/validation_reference.py) against what they must reproduce."""
 
