@@ -9,6 +9,7 @@ Run by ctest (analysis.results) with /usr/bin/python3.
 """
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -497,6 +498,48 @@ class Experiments(unittest.TestCase):
                 json.dump(rec, f)
             with self.assertRaisesRegex(ValueError, "missing cpu"):
                 experiments_table.load(d)
+
+
+class Docs(unittest.TestCase):
+    """The pages a reader reads: no figure left in a commit message, every relative link resolves, pages short."""
+    ROOT = os.path.normpath(os.path.join(HERE, os.pardir))
+    # Phrases that send a reader to a commit message (git's history) for a figure.
+    TO_A_MESSAGE = re.compile(r"commit'?s?'? messages?|messages? of the commits?|readings are in the", re.I)
+
+    def pages(self):
+        docs = os.path.join(self.ROOT, "docs")
+        found = [os.path.join(self.ROOT, "README.md")]
+        for folder, _, names in os.walk(docs):
+            found += [os.path.join(folder, n) for n in sorted(names) if n.endswith(".md")]
+        return found
+
+    def test_no_page_points_to_a_commit_message(self):
+        # the pattern catches the sentences the pages used to hold, so that the check can fail
+        for old in ("the readings are in the message of the commit that made the change",
+                    "the commit's message has the paired readings", "in the messages of the commits that added"):
+            self.assertRegex(old, self.TO_A_MESSAGE)
+        for page in self.pages():
+            with open(page, encoding="utf-8") as f:
+                for n, line in enumerate(f, 1):
+                    self.assertIsNone(self.TO_A_MESSAGE.search(line), f"{os.path.relpath(page, self.ROOT)}:{n}: {line.strip()}")
+
+    def test_every_relative_link_resolves(self):
+        link = re.compile(r"\]\(([^)#\s]+)(#[^)]*)?\)")
+        for page in self.pages():
+            with open(page, encoding="utf-8") as f:
+                text = f.read()
+            for target, _ in link.findall(text):
+                if re.match(r"[a-z]+:", target):
+                    continue  # a URL
+                path = os.path.normpath(os.path.join(os.path.dirname(page), target))
+                self.assertTrue(os.path.exists(path), f"{os.path.relpath(page, self.ROOT)} links {target}, which does not exist")
+
+    def test_pages_are_short(self):
+        for page in self.pages():
+            with open(page, encoding="utf-8") as f:
+                lines = sum(1 for _ in f)
+            limit = 150 if os.sep + "variants" + os.sep in page else 400
+            self.assertLessEqual(lines, limit, os.path.relpath(page, self.ROOT))
 
 
 class ValidationReference(unittest.TestCase):
