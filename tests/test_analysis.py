@@ -430,9 +430,11 @@ class Report(unittest.TestCase):
             self.assertEqual(done.returncode, 0, done.stderr)
             self.assertEqual(done.stdout.strip(), out)
             text = open(out).read()
-            self.assertIn("## Machine and provenance", text)
-            self.assertIn("main/bench_compression_2000.json", text)
-            self.assertIn("sweep_short/bench.json", text)
+            self.assertIn("## Result sets", text)
+            self.assertIn("| [main](main) | Figure 7", text)
+            self.assertIn("| [sweep_short](sweep_short) |", text)
+            with open(os.path.join(root, "main", "set.json")) as f:
+                self.assertEqual(json.load(f)["question"], "Figure 7: each style phase by phase")
             self.assertIn("| arrays | 15.0 (1.00×) | 656.7 (1.00×)", text)  # Figure 7 from the bench sample: µs per step, medians of 2
             for script in ("scripts/run_figures.sh", "scripts/run_peers.sh", "scripts/run_accuracy.sh",
                            "scripts/run_stability.sh", "scripts/run_features.sh", "scripts/run_memory_cost.sh",
@@ -464,6 +466,57 @@ class Report(unittest.TestCase):
             self.assertNotIn("Produce it with `scripts/run_validation.sh`", text)
         finally:
             shutil.rmtree(root)
+
+
+    def test_the_answers_come_first_in_order_then_the_result_sets(self):
+        """On the repository's own results: every answer within the first 60 lines, in order, then provenance."""
+        import report_answers
+        with tempfile.TemporaryDirectory() as d:
+            root = os.path.join(d, "results")
+            shutil.copytree(os.path.join(HERE, os.pardir, "results"), root)
+            out = os.path.join(root, "REPORT.md")
+            done = subprocess.run([sys.executable, os.path.join(ANALYSIS, "make_report.py"), "--results", root, "--out", out],
+                                  capture_output=True, text=True, timeout=300)
+            self.assertEqual(done.returncode, 0, done.stderr)
+            with open(out, encoding="utf-8") as f:
+                lines = f.read().splitlines()
+        screen = "\n".join(lines[:60])
+        where = [screen.find(f"**{a}**") for a in report_answers.ANSWERS]
+        self.assertNotIn(-1, where, [a for a, w in zip(report_answers.ANSWERS, where) if w < 0])
+        self.assertEqual(where, sorted(where))
+        self.assertNotIn("not present", screen)  # every answer's result set is committed
+        self.assertLess(max(where), screen.find("## Result sets") if "## Result sets" in screen else len(screen))
+        self.assertIn("## Result sets", "\n".join(lines))
+        self.assertFalse([l for l in lines[:60] if l.startswith("## ") and l != "## Result sets"])
+        tests = [l for l in lines[:60] if re.match(r"- test \d: ", l)]
+        self.assertEqual(len(tests), 8)  # validation: one line per test
+
+    def test_a_set_measured_before_a_change_of_code_is_marked(self):
+        """The set's commit against the last commit that changed its code (a comment alone is no change)."""
+        import result_sets
+        with tempfile.TemporaryDirectory() as repo:
+            def git(*args):
+                return subprocess.run(["git", "-C", repo, "-c", "user.name=t", "-c", "user.email=t@t", *args],
+                                      capture_output=True, text=True, check=True).stdout.strip()
+
+            def commit(text, message):
+                os.makedirs(os.path.join(repo, "common"), exist_ok=True)
+                with open(os.path.join(repo, "common", "law.cpp"), "w") as f:
+                    f.write(text)
+                git("add", "-A")
+                git("commit", "-qm", message)
+                return git("rev-parse", "HEAD")
+
+            git("init", "-q")
+            measured = commit("int f() { return 1; }\n", "code")
+            prov = {"commits": {measured}, "cpus": {"cpu A"}, "dirty": False}
+            commit("// why f returns 1\nint f() { return 1; }\n", "a comment")
+            self.assertEqual(result_sets.status("", "main", prov, "cpu A", repo), "current")
+            self.assertEqual(result_sets.status("", "main", prov, "cpu B", repo), "another CPU")
+            changed = commit("// why f returns 1\nint f() { return 2; }\n", "code changed")
+            self.assertEqual(result_sets.status("", "main", prov, "cpu A", repo),
+                             f"older than the code it measured (changed at {changed[:10]})")
+            self.assertEqual(result_sets.status("", "main", {**prov, "commits": {changed}}, "cpu A", repo), "current")
 
 
 class Experiments(unittest.TestCase):
