@@ -9,6 +9,7 @@ ancestor of (or is) the commit it measured, and it ran on the report's CPU; othe
 why it is not. A second CPU's set of a question sits beside the first with the CPU in its name
 (`_xeon`), and each set's `set.json` (written by `write_set_files`) names its question and CPU.
 """
+import functools
 import glob
 import json
 import os
@@ -76,6 +77,11 @@ def _git(repo, *args):
 COMMENT = re.compile(r"\s*(//|#|\*|/\*|!|\{|\(\*|$)")  # C++, CMake/shell/Python, Fortran, Pascal, blank
 
 
+@functools.lru_cache(maxsize=None)
+def _last_change(repo, paths, limit):
+    return last_change(repo, list(paths), limit)
+
+
 def last_change(repo, paths, limit=400):
     """The last commit of HEAD that changed a line of code (not only comments or blank lines) in paths,
     or None (no git, or no such paths)."""
@@ -112,7 +118,7 @@ def status(root, folder, prov, report_cpu, repo):
     """'current', or why not: older than the code, another CPU, a dirty tree, or unchecked."""
     why = []
     paths = SETS.get(folder, ("", "", CODE_ALL))[2]
-    change = last_change(repo, paths)
+    change = _last_change(repo, tuple(paths), 400)
     after = [measured_after(repo, change, c) for c in sorted(prov["commits"])]
     if any(a is False for a in after):
         why.append(f"older than the code it measured (changed at {change[:10]})")
