@@ -576,6 +576,14 @@ class Docs(unittest.TestCase):
                 for n, line in enumerate(f, 1):
                     self.assertIsNone(self.TO_A_MESSAGE.search(line), f"{os.path.relpath(page, self.ROOT)}:{n}: {line.strip()}")
 
+    def test_no_file_cites_an_issue_number(self):
+        """A reader of the repository cannot see the issues: comments and pages say why, not which issue."""
+        if not os.path.isdir(os.path.join(self.ROOT, ".git")) and not os.path.isfile(os.path.join(self.ROOT, ".git")):
+            self.skipTest("not a git checkout")
+        pattern = "issue" + " [0-9]"  # split, so that this file does not match itself
+        found = subprocess.run(["git", "-C", self.ROOT, "grep", "-n", "-I", pattern], capture_output=True, text=True)
+        self.assertEqual(found.returncode, 1, found.stdout[:2000])  # 1: nothing found
+
     def test_every_relative_link_resolves(self):
         link = re.compile(r"\]\(([^)#\s]+)(#[^)]*)?\)")
         for page in self.pages():
