@@ -584,16 +584,26 @@ class Docs(unittest.TestCase):
         found = subprocess.run(["git", "-C", self.ROOT, "grep", "-n", "-I", pattern], capture_output=True, text=True)
         self.assertEqual(found.returncode, 1, found.stdout[:2000])  # 1: nothing found
 
+    @staticmethod
+    def anchors(page):
+        """The anchors GitHub makes of a page's headings: lower case, punctuation dropped, spaces as hyphens."""
+        with open(page, encoding="utf-8") as f:
+            heads = [m.group(1).strip().lower() for m in re.finditer(r"^#+ (.*)$", f.read(), flags=re.M)]
+        return {re.sub(r"[^\w\- ]", "", h).replace(" ", "-") for h in heads}
+
     def test_every_relative_link_resolves(self):
-        link = re.compile(r"\]\(([^)#\s]+)(#[^)]*)?\)")
+        link = re.compile(r"\]\(([^)#\s]*)(?:#([^)\s]*))?\)")
         for page in self.pages():
             with open(page, encoding="utf-8") as f:
                 text = f.read()
-            for target, _ in link.findall(text):
+            for target, anchor in link.findall(text):
                 if re.match(r"[a-z]+:", target):
                     continue  # a URL
-                path = os.path.normpath(os.path.join(os.path.dirname(page), target))
-                self.assertTrue(os.path.exists(path), f"{os.path.relpath(page, self.ROOT)} links {target}, which does not exist")
+                path = os.path.normpath(os.path.join(os.path.dirname(page), target)) if target else page
+                name = f"{os.path.relpath(page, self.ROOT)} links {target}#{anchor}"
+                self.assertTrue(os.path.exists(path), f"{name}, which does not exist")
+                if anchor and path.endswith(".md"):
+                    self.assertIn(anchor, self.anchors(path), f"{name}: no such heading")
 
     def test_pages_are_short(self):
         for page in self.pages():
