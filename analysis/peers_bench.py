@@ -30,7 +30,7 @@ PEER_LOG = re.compile(r"^(lammps_native|lammps|liggghts)(?:_t(\d+))?_n(\d+)_(.+)
 SUITE_JSON = re.compile(r"^suite(?:_t\d+)?_n(\d+)_(.+)_r(\d+)\.json$")
 # Debian's binary: the package's build (dpkg-buildflags' defaults, for a baseline x86-64), no OPENMP package.
 DEBIAN_FLAGS = "-g -O2, baseline x86-64"
-# The targets of docs/variants.md ("fast"): (name, the limit, how a cell is read).
+# fast's targets (docs/peers.md, "The benchmark"): the limit of each paired ratio.
 TARGETS = {"peer": 0.5, "loose": 1.5, "order": 1.10, "threads": 1.0}
 
 

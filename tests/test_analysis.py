@@ -516,6 +516,27 @@ class Report(unittest.TestCase):
             shutil.rmtree(root)
 
 
+    def test_fast_beside_both_lammps_builds_is_a_section_naming_their_flags(self):
+        import pandas as pd
+        import plot_peers
+        root = tempfile.mkdtemp()
+        self.addCleanup(shutil.rmtree, root)
+        rows = [{"code": code, "variant": code if code != "suite" else "fast", "threads": 1, "particles": 1000, "stage": "bed",
+                 "repetition": 0, "steps": 1000, "phase": "total", "seconds_per_step": t}
+                for code, t in (("suite", 4e-5), ("lammps_native", 1e-4), ("lammps", 1.2e-4))]
+        out = os.path.join(root, "peers_fast_xeon")
+        plot_peers.write_bench(pd.DataFrame(rows), {"cpu": "test CPU"}, PeersBench.NATIVE, out,
+                               os.path.join(out, "peers_us_per_particle_step.png"))
+        report = os.path.join(root, "REPORT.md")
+        done = subprocess.run([sys.executable, os.path.join(ANALYSIS, "make_report.py"), "--results", root, "--out", report],
+                              capture_output=True, text=True, timeout=120)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        with open(report) as f:
+            text = f.read().split("## fast beside LAMMPS built for the CPU and Debian's binary (peers_fast_xeon)")[1]
+        self.assertIn("| LAMMPS -O3 -march=native | 1.00 |", text)
+        self.assertIn("| LAMMPS Debian (-g -O2, baseline x86-64) | 1.20 |", text)
+        self.assertIn("peers_fast_xeon/peers_us_per_particle_step.png", text)
+
     def test_validation_summary_counts_each_verdict(self):
         """Chung & Ooi's summary: passes over judged values, and the paper's law's expected differences apart."""
         root = tempfile.mkdtemp()
