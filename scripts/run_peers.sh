@@ -12,14 +12,15 @@
 #     kinetic energy and bed height while settling, the wall force while compressing; results/peers/physics_*.
 # Usage: scripts/run_peers.sh [--full] [--n "1000 2000"] [--steps K] [--repetitions R] [--variants LIST]
 #                             [--threads "1 2"] [--members M] [--physics-n N] [--bench-only] [--physics-only]
-#                             [--prepare-only] [--contact "KEY=VALUE ..."] [--diagnose] [--note TEXT]
-#                             [--out DIR] [--build-dir DIR]
+#                             [--prepare-only] [--contact "KEY=VALUE ..."] [--diagnose] [--no-liggghts]
+#                             [--note TEXT] [--out DIR] [--build-dir DIR]
 #   default          N = 1000, 2000, 4000; 200 steps; 3 repetitions; every variant; one thread;
 #                    4 ensemble members
 #   --full           N = 1000 … 64000 (doubling), 500 steps, 5 repetitions, threads 1 and 2, 8 ensemble
 #                    members (the lead's run)
 #   --threads LIST   the thread counts of the benchmark: 1 times every code on one core; T > 1 the suite's
 #                    threaded variants on T threads beside LAMMPS built here with -sf omp -pk omp T
+#   --no-liggghts    LIGGGHTS left out (a run about the suite and LAMMPS alone)
 #   --note TEXT      a sentence for the results' header (what the tables cannot say: a shared machine)
 #   --steps K        the timed steps of each run, at least: a small N runs more, so that every timed run
 #                    holds at least 10^6 particle-steps (1000 steps at N = 1000), long enough that a burst
@@ -44,7 +45,7 @@
 source "$(dirname "$0")/lib.sh"
 ns="1000 2000 4000"; steps=200; reps=3; variants=all; members=4; phys_n=2000; warmup=20
 do_bench=1; do_phys=1; prepare_only=0; diagnose=0; out=results/peers; figures=results/figures; contact=""
-threads=1; note=""
+threads=1; note=""; no_liggghts=0
 while [[ $# -gt 0 ]]; do
   case "$1" in
     --full) ns="1000 2000 4000 8000 16000 32000 64000"; steps=500; reps=5; threads="1 2"; members=8; shift ;;
@@ -54,6 +55,7 @@ while [[ $# -gt 0 ]]; do
     --variants) need_value "$@"; variants=$2; shift 2 ;;
     --threads) need_value "$@"; threads=$2; shift 2 ;;
     --note) need_value "$@"; note=$2; shift 2 ;;
+    --no-liggghts) no_liggghts=1; shift ;;
     --members) need_value "$@"; members=$2; shift 2 ;;
     --physics-n) need_value "$@"; phys_n=$2; shift 2 ;;
     --bench-only) do_phys=0; shift ;;
@@ -82,6 +84,7 @@ if [[ $diagnose == 1 && $do_phys == 1 ]]; then
 fi
 lmp=$(command -v lmp || true)
 liggghts=$(command -v liggghts || true)
+[[ $no_liggghts == 1 ]] && liggghts=""
 # A contact law: its stages live in a folder of their own beside the paper's (law_<keys>), its scene
 # options are checked now (a scene of one grain), before any settling.
 contact_args=(); law_dir=""
