@@ -1,5 +1,6 @@
 // The scene's [contact] table (docs/scene-format.md): which law of physics.md §9 a run uses.
 #include "contact_model_toml.hpp"
+#include "toml_numbers.hpp"
 
 #include <cerrno>
 #include <cmath>
@@ -66,12 +67,9 @@ public:
         if (!has(key)) fail(fmt::format("missing key 'contact.{}' (needed by {})", key, needed_by));
         used_.insert(key);
         const auto& x = v_.as_table().at(key);
-        double d = 0.0;
-        if (x.is_floating()) d = x.as_floating();
-        else if (x.is_integer()) d = double(x.as_integer());
-        else fail(fmt::format("'contact.{}' must be a number", key));
-        if (!std::isfinite(d)) fail(fmt::format("'contact.{}' must be finite (got {})", key, d));
-        return d;
+        if (!x.is_floating() && !x.is_integer()) fail(fmt::format("'contact.{}' must be a number", key));
+        if (const std::string problem = toml_number_problem(x, "contact." + key); !problem.empty()) fail(problem);
+        return x.is_floating() ? x.as_floating() : double(x.as_integer());
     }
     double positive(const std::string& key, const std::string& needed_by)
     {

@@ -1,7 +1,6 @@
 #include "demmat/scene.hpp"
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <limits>
@@ -14,6 +13,7 @@
 #include <toml.hpp>
 
 #include "contact_model_toml.hpp"
+#include "toml_numbers.hpp"
 #include "demmat/error.hpp"
 #include "demmat/io.hpp"
 #include "demmat/stability.hpp"
@@ -91,35 +91,12 @@ public:
     {
         return has(key) ? written(v_.as_table().at(key)) : fmt::format("{}", d);
     }
-    // A number as a double, refused with its text as written when a double cannot hold it: toml11 reads
-    // 1e400 as the largest double and 1e-400 as 0 without a word.
     double value_of(const toml::value& x, const std::string& name) const
     {
-        const double d = x.is_floating() ? x.as_floating() : double(x.as_integer());
-        const std::string text = written(x);
-        if (!std::isfinite(d)) fail(fmt::format("'{}' must be finite (got {})", name, text));
-        if (x.is_floating()) {
-            std::string plain;
-            for (char c : text)
-                if (c != '_') plain += c;
-            errno = 0;
-            const double exact = std::strtod(plain.c_str(), nullptr);
-            const bool nonzero_digit = plain.find_first_of("123456789") < plain.find_first_of("eE");
-            if (errno == ERANGE && std::abs(exact) > 1.0)
-                fail(fmt::format("'{}' = {} is beyond the range of a double (about 1.8e308)", name, text));
-            if (nonzero_digit && d == 0.0)
-                fail(fmt::format("'{}' = {} is below the range of a double (it would read as 0)", name, text));
-        }
-        return d;
+        if (const std::string problem = toml_number_problem(x, name); !problem.empty()) fail(problem);
+        return x.is_floating() ? x.as_floating() : double(x.as_integer());
     }
-    // The text of a value as the file writes it (toml11's location), or the value printed when unknown.
-    static std::string written(const toml::value& x)
-    {
-        const auto where = x.location();
-        if (where.column() >= 1 && where.region() >= 1 && where.column() - 1 + where.region() <= where.line_str().size())
-            return printable(where.line_str().substr(where.column() - 1, where.region()));
-        return x.is_floating() ? fmt::format("{}", x.as_floating()) : x.is_integer() ? std::to_string(x.as_integer()) : "?";
-    }
+    static std::string written(const toml::value& x) { return toml_written(x); }
     // An integer in [lo, hi]. The message quotes the number as written: toml11 clamps a literal beyond
     // 64 bits to the nearest limit, and a narrowing cast would wrap (4294967297 into an int is 1).
     std::int64_t integer(const std::string& key, std::int64_t fallback, std::int64_t lo, std::int64_t hi)
