@@ -24,6 +24,8 @@
 #include "demmat/provenance.hpp"
 #include "demmat/registry.hpp"
 #include "demmat/run_log.hpp"
+#include "demmat/scene_toml.hpp"
+#include "demmat/state_file.hpp"
 #include "demmat/text.hpp"
 #include "demmat/chung_ooi.hpp"
 #include "demmat/scenes.hpp"

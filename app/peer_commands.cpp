@@ -12,7 +12,9 @@
 #include "demmat/io.hpp"
 #include "demmat/peer_io.hpp"
 #include "demmat/registry.hpp"
+#include "demmat/scene_toml.hpp"
 #include "demmat/stability.hpp"
+#include "demmat/state_file.hpp"
 #include "cli_ranges.hpp"
 
 namespace fs = std::filesystem;

@@ -24,6 +24,7 @@
 #include "demmat/registry.hpp"
 #include "demmat/scenes.hpp"
 #include "demmat/stability.hpp"
+#include "demmat/state_file.hpp"
 
 using namespace demmat;
 using json = nlohmann::json;

@@ -43,6 +43,7 @@
 #include "demmat/output.hpp"
 #include "demmat/problem.hpp"
 #include "demmat/registry.hpp"
+#include "demmat/state_file.hpp"
 #include "demmat/text.hpp"
 #include "demmat/threads.hpp"
 #include "demmat/scenes.hpp"

@@ -6,8 +6,10 @@
 #include <string>
 
 #include "demmat/scene.hpp"
+#include "demmat/scene_toml.hpp"
 #include "demmat/stability.hpp"
 #include "demmat/state.hpp"
+#include "demmat/state_file.hpp"
 #include "fuzz_common.hpp"
 
 using namespace demmat;

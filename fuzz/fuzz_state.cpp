@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include "demmat/state.hpp"
+#include "demmat/state_file.hpp"
 #include "fuzz_common.hpp"
 
 using namespace demmat;

@@ -12,7 +12,7 @@
 // wall_name:K (VALUE: the byte code that replaces the last character of wall K's name).
 // VALUE: a number, or nan / inf / -inf.
 //
-// Written independently of common/src/state.cpp on purpose: a test tool that reused the reader's code
+// Written independently of harness/src/state_file.cpp on purpose: a test tool that reused the reader's code
 // would share its mistakes.
 #include <cstdint>
 #include <cstdlib>

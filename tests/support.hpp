@@ -15,6 +15,7 @@
 #include "demmat/problem.hpp"
 #include "demmat/registry.hpp"
 #include "demmat/scenes.hpp"
+#include "demmat/state_file.hpp"
 
 namespace demmat::test {
 

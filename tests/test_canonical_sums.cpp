@@ -18,7 +18,7 @@
 #include <utility>
 #include <vector>
 
-#include "demmat/soa/canonical_sums.hpp"
+#include "demmat/lane_engine/canonical_sums.hpp"
 
 using namespace demmat;
 using namespace demmat::fast;

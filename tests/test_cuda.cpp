@@ -13,6 +13,7 @@
 
 #include "cuda_host.hpp"
 #include "demmat/error.hpp"
+#include "demmat/state_file.hpp"
 #include "host_backend.hpp"
 #include "support.hpp"
 

@@ -16,6 +16,7 @@
 
 #include <gtest/gtest.h>
 
+#include "demmat/state_file.hpp"
 #include "demmat/threads.hpp"
 #include "fast.hpp"
 #include "fast_support.hpp"

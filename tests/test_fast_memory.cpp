@@ -19,6 +19,7 @@
 
 #include "demmat/contact_model.hpp"
 #include "demmat/features.hpp"
+#include "demmat/state_file.hpp"
 #include "fast_support.hpp"
 #include "support.hpp"
 

@@ -9,6 +9,8 @@
 
 #include "demmat/error.hpp"
 #include "demmat/features.hpp"
+#include "demmat/scene_toml.hpp"
+#include "demmat/state_file.hpp"
 
 #include "support.hpp"
 

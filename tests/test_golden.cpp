@@ -30,6 +30,8 @@
 
 #include "demmat/io.hpp"
 #include "demmat/model.hpp"
+#include "demmat/scene_toml.hpp"
+#include "demmat/state_file.hpp"
 
 #include "support.hpp"
 

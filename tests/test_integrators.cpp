@@ -9,6 +9,7 @@
 
 #include "demmat/error.hpp"
 #include "demmat/integrators.hpp"
+#include "demmat/scene_toml.hpp"
 #include "support.hpp"
 
 using namespace demmat;

@@ -17,6 +17,8 @@
 
 #include "demmat/contact_memory.hpp"
 #include "demmat/features.hpp"
+#include "demmat/scene_toml.hpp"
+#include "demmat/state_file.hpp"
 
 #include "support.hpp"
 

@@ -21,6 +21,7 @@
 #include <gtest/gtest.h>
 
 #include "demmat/contact_model.hpp"
+#include "demmat/state_file.hpp"
 
 #include "support.hpp"
 

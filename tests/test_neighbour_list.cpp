@@ -1,4 +1,4 @@
-// fast's neighbour list (soa/neighbour_list.hpp on soa/cell_order.hpp): after a rebuild's cell sort and
+// fast's neighbour list (lane_engine/neighbour_list.hpp on lane_engine/cell_order.hpp): after a rebuild's cell sort and
 // permutation, the slots hold every pair closer than R_i + R_j + skin (may_touch with each radius grown
 // by skin/2) exactly once, stored with the particle that comes first in storage, the lower id its owner
 // (the law's i), and no other pair: checked against all N(N-1)/2 pairs of a polydisperse cloud, on the
@@ -16,9 +16,10 @@
 
 #include "demmat/problem.hpp"
 #include "demmat/scenes.hpp"
-#include "demmat/soa/cell_order.hpp"
-#include "demmat/soa/neighbour_list.hpp"
-#include "demmat/soa/particles.hpp"
+#include "demmat/lane_engine/cell_order.hpp"
+#include "demmat/lane_engine/neighbour_list.hpp"
+#include "demmat/lane_engine/particles.hpp"
+#include "demmat/state_file.hpp"
 
 using namespace demmat;
 using namespace demmat::fast;

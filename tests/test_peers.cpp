@@ -13,6 +13,7 @@
 
 #include "demmat/io.hpp"
 #include "demmat/peer_io.hpp"
+#include "demmat/state_file.hpp"
 #include "support.hpp"
 
 namespace demmat {

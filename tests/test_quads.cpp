@@ -4,7 +4,7 @@
 // a wrong force on the wrong particle, which the equivalence tests find only on targets of that width.
 #include <gtest/gtest.h>
 
-#include "demmat/soa/quads.hpp"
+#include "demmat/lane_engine/quads.hpp"
 
 using namespace demmat;
 using namespace demmat::fast;

@@ -3,7 +3,9 @@
 #include <gtest/gtest.h>
 
 #include "demmat/error.hpp"
+#include "demmat/scene_toml.hpp"
 #include "demmat/stability.hpp"
+#include "demmat/state_file.hpp"
 #include "support.hpp"
 
 using namespace demmat;

@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include "demmat/error.hpp"
+#include "demmat/state_file.hpp"
 #include "support.hpp"
 
 using namespace demmat;

@@ -1,4 +1,4 @@
-// fast's teams (soa/team.hpp, in_team): a region asked for in parallel runs on a team only where OpenMP
+// fast's teams (lane_engine/team.hpp, in_team): a region asked for in parallel runs on a team only where OpenMP
 // may give more than one thread; otherwise its body runs once on this thread, outside any parallel
 // region (no team of one, whose barriers are system calls each step), and its directives still do
 // their work: a worksharing loop covers its range exactly once, a single runs once, thread_count() is 1.
@@ -8,7 +8,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "demmat/soa/team.hpp"
+#include "demmat/lane_engine/team.hpp"
 
 using namespace demmat::fast;
 

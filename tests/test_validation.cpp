@@ -10,6 +10,7 @@
 #include "demmat/contact_memory.hpp"
 #include "demmat/error.hpp"
 #include "demmat/registry.hpp"
+#include "demmat/scene_toml.hpp"
 #include "demmat/scenes.hpp"
 #include "demmat/stability.hpp"
 #include "support.hpp"

@@ -17,6 +17,8 @@
 #include "lockstep.hpp"
 #include "mpi_variant.hpp"
 #include "support.hpp"
+#include "demmat/scene_toml.hpp"
+#include "demmat/state_file.hpp"
 
 using namespace demmat;
 using namespace demmat::mpi;

@@ -60,7 +60,7 @@ void search_all_pairs(std::size_t n, const T* x, const T* r, NeighbourList& nl)
     over.check(nl.cap);
 }
 
-// Linked cells (common/linked_cells.hpp); partners j > i stored in ascending order, as the canonical
+// Linked cells (core/include/demmat/linked_cells.hpp); partners j > i stored in ascending order, as the canonical
 // order needs. On overflow the search goes on counting so the message can give the value that fits.
 template <class T>
 void search_cells(std::size_t n, const T* x, const T* r, T edge, LinkedCells& cells, NeighbourList& nl)

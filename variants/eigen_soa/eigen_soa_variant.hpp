@@ -365,7 +365,7 @@ private:
         over.check(nl_.cap);
     }
 
-    // Linked cells (common/linked_cells.hpp) on the three position columns; partners j > i stored
+    // Linked cells (core/include/demmat/linked_cells.hpp) on the three position columns; partners j > i stored
     // ascending in the particle's compressed row, as the canonical order needs.
     void search_cells()
     {

@@ -7,7 +7,7 @@
 ! INTERFACE block of module demmat_f90_kernels (the paper's style); they use no module data. Capacities are
 ! fixed at init; an overflow is reported to C++ as a status code (C++ throws CapacityError /
 ! InstabilityError with the messages of the arrays variant). Every expression mirrors
-! common/include/demmat/{gear,contact_law}.hpp operation for operation; the parentheses spell
+! core/include/demmat/{gear,contact_law}.hpp operation for operation; the parentheses spell
 ! out C++'s left-to-right evaluation (Fortran honours parentheses), so the trajectories are
 ! bit-identical to the C++ variants (physics.md section 6). Constants (Gear coefficients, contact
 ! parameters) are passed in from C++, never recomputed here.

@@ -1,5 +1,5 @@
 // The Fortran 90 port of the arrays processor (the paper's DEMMAT_F90), demmat_f90.f90, driven through
-// its bind(C) entry points by the shared PortVariant (common/include/demmat/port_variant.hpp).
+// its bind(C) entry points by the shared PortVariant (engines/ports/include/demmat/port_variant.hpp).
 #include <cstdint>
 #include <memory>
 

@@ -10,12 +10,12 @@
 #include <utility>
 #include <vector>
 
-#include "demmat/soa/heap_bytes.hpp"
-#include "demmat/soa/neighbour_list.hpp"
-#include "demmat/soa/pair_kernel.hpp"
-#include "demmat/soa/particles.hpp"
-#include "demmat/soa/team.hpp"
-#include "demmat/soa/wall_contacts.hpp"
+#include "demmat/lane_engine/heap_bytes.hpp"
+#include "demmat/lane_engine/neighbour_list.hpp"
+#include "demmat/lane_engine/pair_kernel.hpp"
+#include "demmat/lane_engine/particles.hpp"
+#include "demmat/lane_engine/team.hpp"
+#include "demmat/lane_engine/wall_contacts.hpp"
 
 namespace demmat::fast {
 

@@ -189,7 +189,7 @@ private:
         }
     }
 
-    // Linked cells (common/linked_cells.hpp); a particle's candidates j > i gathered ascending in a
+    // Linked cells (core/include/demmat/linked_cells.hpp); a particle's candidates j > i gathered ascending in a
     // scratch row, then merged into its list.
     void search_cells()
     {

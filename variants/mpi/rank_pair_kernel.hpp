@@ -1,12 +1,12 @@
 #pragma once
-// A rank's pairs through the shared pair kernel on lanes (demmat/soa/pair_kernel.hpp, the kernel fast
+// A rank's pairs through the shared pair kernel on lanes (demmat/lane_engine/pair_kernel.hpp, the kernel fast
 // runs), under the paper's law and the laws of physics.md §9. The rank's particles, owned and ghosts,
-// get the kernel's records (one record of three quads per particle, soa/particles.hpp); its listed
+// get the kernel's records (one record of three quads per particle, lane_engine/particles.hpp); its listed
 // pairs (lower id as i) become the kernel's slots, each contact's force and torques into its slot, zeros
 // where the pair is out of contact; the rank's canonical gather then reads the slots
 // (rank_processor.hpp), a block of particles at a time (the list's order, rank_list.hpp), from a ring
 // that stays in cache, as fast's sweep does. Under a law with memory each pair's stretch is a record of
-// fast's (soa/pair_stretches.hpp) beside it, advanced by the kernel. Each lane has the scalar law's
+// fast's (lane_engine/pair_stretches.hpp) beside it, advanced by the kernel. Each lane has the scalar law's
 // bits, so the slots hold what particle_contact and particle_contact_memory give.
 #include <algorithm>
 #include <bit>
@@ -14,12 +14,12 @@
 #include <vector>
 
 #include "demmat/model.hpp"
-#include "demmat/soa/neighbour_list.hpp"
+#include "demmat/lane_engine/neighbour_list.hpp"
 #include "demmat/contact_memory.hpp"
-#include "demmat/soa/pair_kernel.hpp"
-#include "demmat/soa/pair_stretches.hpp"
-#include "demmat/soa/particles.hpp"
-#include "demmat/soa/wall_contacts.hpp"
+#include "demmat/lane_engine/pair_kernel.hpp"
+#include "demmat/lane_engine/pair_stretches.hpp"
+#include "demmat/lane_engine/particles.hpp"
+#include "demmat/lane_engine/wall_contacts.hpp"
 #include "rank_particles.hpp"
 
 namespace demmat::mpi {

@@ -50,7 +50,7 @@
 #include "demmat/contact_memory.hpp"
 #include "demmat/error.hpp"
 #include "demmat/integrators.hpp"
-#include "demmat/soa/cell_order.hpp"
+#include "demmat/lane_engine/cell_order.hpp"
 
 namespace demmat::mpi {
 
@@ -350,7 +350,7 @@ private:
         migrants_ += halo_.migrate(comm_, p_, M::memory ? &st_ : nullptr);
     }
 
-    // The owned particles into fast's cell order (soa/cell_order.hpp), so that the list's pairs, the
+    // The owned particles into fast's cell order (lane_engine/cell_order.hpp), so that the list's pairs, the
     // kernel's records and the slots each sum reads lie near one another in memory. The local order
     // changes no bits: every sum is in the order of ids.
     void sort_owned()

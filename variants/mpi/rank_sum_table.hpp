@@ -10,7 +10,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "demmat/soa/heap_bytes.hpp"
+#include "demmat/lane_engine/heap_bytes.hpp"
 #include "rank_list.hpp"
 
 namespace demmat::mpi {

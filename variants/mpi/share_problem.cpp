@@ -4,6 +4,7 @@
 
 #include "mpi_variant.hpp"
 #include "demmat/error.hpp"
+#include "demmat/scene_toml.hpp"
 
 namespace demmat::mpi {
 

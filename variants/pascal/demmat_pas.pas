@@ -8,7 +8,7 @@
   C++ wrapper then throws demmat::Error. Not thread-safe (create/destroy touch the global table).
 
   Layout: each (N, 3) array is column-major, element (i, c) at c*N + i, i and c 0-based.
-  Bit identity (physics.md section 6): every expression mirrors common/include/demmat/gear.hpp and contact_law.hpp
+  Bit identity (physics.md section 6): every expression mirrors core/include/demmat/gear.hpp and contact_law.hpp
   operation for operation, parenthesised in C++'s left-to-right order; h^(3/2) = h*sqrt(h); everything is
   Double evaluated with SSE2 (no x87 Extended: literals are typed Double constants, no float literal
   appears inside an expression); no fast-math, no FMA. Gear coefficients, contact parameters, gravity and

@@ -1,6 +1,6 @@
 // The Object Pascal port of the arrays processor (the paper's DEMMAT_PAS), demmat_pas.pas, built by fpc
 // into libdemmat_pas.so and driven through its cdecl exports by the shared PortVariant
-// (common/include/demmat/port_variant.hpp). The Pascal state lives in global dynamic arrays, one record
+// (engines/ports/include/demmat/port_variant.hpp). The Pascal state lives in global dynamic arrays, one record
 // per instance slot (a small fixed table, demmat_pas_max_instances()); a handle is a slot index, and
 // creating one more instance than there are slots throws demmat::Error.
 #include <cstdint>

@@ -1,4 +1,4 @@
-#include "demmat/state.hpp"
+#include "demmat/state_file.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -3,7 +3,7 @@
 // exposes C-compatible entry points over its own state, and this one class moves data across the
 // language boundary and turns the port's status codes into the exceptions, with the messages, of the
 // arrays variant. A port supplies its entry points as a PortApi; the physics stays in the port, which
-// mirrors common/'s kernels operation for operation.
+// mirrors the core's kernels operation for operation.
 #include <cstdint>
 #include <string>
 #include <vector>

@@ -112,19 +112,6 @@ struct Scene {
     std::uint64_t fingerprint(std::size_t particle_count) const;
 };
 
-// The largest scene file read (1 GiB): a TOML scene is text a person edits; toml11 holds several times
-// the text in memory, and a list of 10^6 particles is about 200 MB (larger sets come from a state file
-// or the grid generator). The cap also stops a device such as /dev/zero at once (io.hpp, read_input_file).
-inline constexpr std::uintmax_t kMaxSceneBytes = std::uintmax_t(1) << 30;
-
-Scene load_scene(const std::filesystem::path& file);
-// A command's --integrator/--precision (either may be empty: unchanged), replacing the scene's
-// [integrator] before anything depends on it (the time-step check compares Δt with the chosen scheme's
-// stability limit); an unknown name is a one-line error.
-void override_integrator(Scene& s, const std::string& integrator, const std::string& precision);
-Scene parse_scene(const std::string& toml_text, const std::string& label);
-std::string scene_to_toml(const Scene& scene);
-
 // The six faces of a box as walls, normals into the box, named x_min … z_max.
 std::vector<Wall> box_walls(const Box& box);
 Wall box_face(const Box& box, const std::string& face);

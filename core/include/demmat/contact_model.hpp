@@ -38,9 +38,4 @@ const char* name(NormalDamping d);
 const char* name(TangentialModel t);
 const char* name(RollingModel r);
 
-// The [contact] table itself is read by parse_contact_model (common/src/contact_model_toml.hpp).
-
-// `demmat scene --contact KEY=VALUE …`: the same keys and checks as the table.
-ContactModel contact_model_from_options(const std::vector<std::string>& key_values);
-
 } // namespace demmat

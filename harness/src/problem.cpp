@@ -4,6 +4,8 @@
 
 #include "demmat/driver.hpp"
 #include "demmat/error.hpp"
+#include "demmat/scene_toml.hpp"
+#include "demmat/state_file.hpp"
 
 namespace demmat {
 

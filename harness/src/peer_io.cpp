@@ -13,6 +13,7 @@
 #include "demmat/error.hpp"
 #include "demmat/io.hpp"
 #include "demmat/reference.hpp"
+#include "demmat/state_file.hpp"
 
 namespace demmat {
 

@@ -1,0 +1,3 @@
+#pragma once
+// Right: a variant includes an engine.
+#include "demmat/e1/a.hpp"
