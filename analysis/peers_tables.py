@@ -140,7 +140,9 @@ def targets(df, med, versions, ns):
         lines.append(f"| fast's loose grid ≤ {TARGETS['loose']}× its settled bed, one core | per particle-step | " + " | ".join(cells) + " |")
     for t in sorted(x for x in med.threads.unique() if x > 1):
         for stage in timed:
-            cells = [verdict(fast.paired_ratio.get((t, stage, n), float("nan")), TARGETS["threads"], strict=True) for n in ns]
+            # † where fast ran on fewer threads than asked (a small bed): its verdict is then about one thread.
+            cells = [verdict(fast.paired_ratio.get((t, stage, n), float("nan")), TARGETS["threads"], strict=True)
+                     + (" †" if fast.ran_on.get((t, stage, n), t) < t else "") for n in ns]
             lines.append(f"| fast on {t} threads faster than {label('lammps_native', versions, t)} | {STAGE_TITLE[stage]} | "
                          + " | ".join(cells) + " |")
     return lines + [""]
@@ -193,7 +195,8 @@ def markdown(df, med, ref, provenance, versions):
                       f"The threaded codes on {threads} threads: the suite's threaded variants (`demmat bench --threads`) and "
                       f"LAMMPS built here with `-sf omp -pk omp {threads}` (its OPENMP package: a style with an /omp version "
                       "runs threaded, any other as on one thread; docs/peers.md). Ratios to LAMMPS OPENMP at the same threads; "
-                      "† marks a run on fewer threads than asked (fast runs a bed of fewer than 3000 grains on one).", ""]
+                      "† marks a run on fewer threads than asked (fast runs a bed of fewer than 3000 grains on one). "
+                      f"OMP_WAIT_POLICY: {versions.get('omp_wait_policy', 'not recorded')}.", ""]
         for stage in STAGES:
             lines += stage_tables(df, med, ref, versions, stage, threads, ns)
         if threads > 1:

@@ -373,6 +373,8 @@ class PeersBench(unittest.TestCase):
         speed_up = two.split("### From one thread to 2")[1]
         self.assertIn("| fast, 2 threads | settled bed | 1.33 |", speed_up)
         self.assertIn("| LAMMPS -O3 -march=native, OPENMP 2 threads | settled bed | 1.67 |", speed_up)
+        # the target's verdict carries the mark too: fast ran this bed on one thread
+        self.assertIn("| fast on 2 threads faster than LAMMPS -O3 -march=native, OPENMP 2 threads | settled bed | 0.50 met † |", text)
 
     def test_targets_are_each_repetitions_ratio_against_its_limit(self):
         rows = []
