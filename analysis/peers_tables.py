@@ -172,6 +172,19 @@ def phase_table(phases, stage, versions):
     return lines + [""]
 
 
+def cpu_use_note(df):
+    """How much of a core LAMMPS's one-thread runs had (its own '% CPU use' line): a measure of the load
+    that other work put on the machine while this ran."""
+    if "cpu_use" not in df:
+        return []
+    c = df[(df.phase == "total") & (df.threads == 1) & df.code.str.startswith("lammps")].cpu_use.dropna()
+    if c.empty:
+        return []
+    return [f"LAMMPS's one-thread runs had {100 * c.median():.0f} % of a core (median; {100 * c.min():.0f}–{100 * c.max():.0f} %, "
+            f"its own '% CPU use' line, CPU time over wall time over {len(c)} runs): the rest of the wall time they "
+            "waited for the core.", ""]
+
+
 def markdown(df, med, ref, provenance, versions):
     """The whole bench_peers.md."""
     prov = provenance or {}
@@ -185,6 +198,7 @@ def markdown(df, med, ref, provenance, versions):
              "then the paired ratios. Produced by scripts/run_peers.sh; every sample in bench_peers.json.", ""]
     if versions.get("note"):
         lines += [versions["note"], ""]
+    lines += cpu_use_note(df)
     lines += [steps_note(df), "",
               f"Contact law: {versions.get('contact_law', 'the paper' + chr(39) + 's (physics.md section 2)')}.", ""]
     for threads in sorted(med.threads.unique()):

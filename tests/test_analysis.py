@@ -8,6 +8,7 @@ mpi_bench_sample.json of `mpirun -np 2 demmat_mpi bench --json` (the loose bed o
 Run by ctest (analysis.results) with /usr/bin/python3.
 """
 import json
+import math
 import os
 import re
 import shutil
@@ -411,6 +412,18 @@ class PeersBench(unittest.TestCase):
         df, _ = peers_bench.read_work(self.work)
         got = sorted(set(zip(df.code, df.threads, df.stage, df.repetition)))
         self.assertEqual(got, [("lammps", 1, "bed", 0), ("lammps", 1, "compression", 2), ("lammps_native", 2, "bed", 1)])
+
+    def test_lammps_cpu_use_of_the_last_loop_is_read_and_summarised(self):
+        import peers_bench
+        log = LAMMPS_LOG.replace("Loop time of 3.16708 on 1 procs for 200 steps with 64000 atoms\n",
+                                 "Loop time of 3.16708 on 1 procs for 200 steps with 64000 atoms\n\n27.5% CPU use with 1 MPI tasks x 1 OpenMP threads\n")
+        log = log.replace("Loop time of 0.305351 on 1 procs for 20 steps with 64000 atoms\n",
+                          "Loop time of 0.305351 on 1 procs for 20 steps with 64000 atoms\n\n99.0% CPU use with 1 MPI tasks x 1 OpenMP threads\n")
+        self.assertAlmostEqual(peers_bench.read_cpu_use(self.log("a.out", log)), 0.275)   # the timed loop's, not the warm-up's
+        self.assertTrue(math.isnan(peers_bench.read_cpu_use(self.log("b.out", LIGGGHTS_LOG))))
+        rows = [dict(self.sample("lammps_native", "lammps_native", 1, "bed", r, 1e-4), cpu_use=c) for r, c in enumerate((0.2, 0.3, 0.9))]
+        rows.append(self.sample("suite", "fast", 1, "bed", 0, 4e-5))
+        self.assertIn("LAMMPS's one-thread runs had 30 % of a core (median; 20–90 %", self.bench_md(rows, self.NATIVE))
 
 
 class PeerContacts(unittest.TestCase):
