@@ -217,7 +217,7 @@ def build(root, out, paper):
                 "the ensemble cross-check with a law of physics.md §9", f"scripts/run_peers.sh --contact \"{keys}\" --out results/{folder}")
     # fast beside LAMMPS on each CPU that has a run: both LAMMPS builds named with their flags, fast's targets.
     for folder in sorted(os.path.basename(f) for f in glob.glob(os.path.join(root, "peers_fast*"))):
-        section(rep, f"fast beside LAMMPS built for the CPU and Debian's binary ({folder})", [f"{folder}/bench_peers.md"],
+        section(rep, f"fast beside LAMMPS ({folder})", [f"{folder}/bench_peers.md"],
                 [(f"{folder}/peers_us_per_particle_step.png", f"µs per particle-step against N ({folder})")],
                 "fast's targets beside LAMMPS", f"scripts/run_peers.sh --bench-only --variants fast,fast_unordered --out results/{folder}")
     section(rep, "What contact memory costs each style", ["memory_cost/table.md"], [("memory_cost/memory_cost.png", "memory cost")],

@@ -60,6 +60,14 @@ def read_peer_log(path):
                               "rest": (total - pair - neigh) / steps}
 
 
+def read_cpu_use(path):
+    """LAMMPS's own share of a core in its last loop ('X% CPU use with ...': CPU time over wall time), a
+    fraction; NaN where the log has none (LIGGGHTS). Below 1 on one thread: the run waited for the core."""
+    with open(path) as f:
+        found = re.findall(r"^(\S+)% CPU use with", f.read(), re.M)
+    return float(found[-1]) / 100.0 if found else float("nan")
+
+
 def read_work(work):
     """Every sample of a run's work folder: the suite's `demmat bench --json` files and the peers' logs."""
     rows, provenance = [], None
@@ -83,8 +91,10 @@ def read_work(work):
         steps, particles, seconds = read_peer_log(f)
         if particles != n:
             sys.exit(f"plot_peers.py: {f}: {particles} atoms, not the {n} of its name")
+        cpu = read_cpu_use(f)
         rows += [{"code": code, "variant": code, "threads": threads, "ran_on": threads, "particles": n, "stage": stage,
-                  "repetition": rep, "steps": steps, "phase": phase, "seconds_per_step": t} for phase, t in seconds.items()]
+                  "repetition": rep, "steps": steps, "phase": phase, "seconds_per_step": t, "cpu_use": cpu}
+                 for phase, t in seconds.items()]
     return pd.DataFrame(rows), provenance
 
 

@@ -140,7 +140,9 @@ def targets(df, med, versions, ns):
         lines.append(f"| fast's loose grid ≤ {TARGETS['loose']}× its settled bed, one core | per particle-step | " + " | ".join(cells) + " |")
     for t in sorted(x for x in med.threads.unique() if x > 1):
         for stage in timed:
-            cells = [verdict(fast.paired_ratio.get((t, stage, n), float("nan")), TARGETS["threads"], strict=True) for n in ns]
+            # † where fast ran on fewer threads than asked (a small bed): its verdict is then about one thread.
+            cells = [verdict(fast.paired_ratio.get((t, stage, n), float("nan")), TARGETS["threads"], strict=True)
+                     + (" †" if fast.ran_on.get((t, stage, n), t) < t else "") for n in ns]
             lines.append(f"| fast on {t} threads faster than {label('lammps_native', versions, t)} | {STAGE_TITLE[stage]} | "
                          + " | ".join(cells) + " |")
     return lines + [""]
@@ -170,6 +172,19 @@ def phase_table(phases, stage, versions):
     return lines + [""]
 
 
+def cpu_use_note(df):
+    """How much of a core LAMMPS's one-thread runs had (its own '% CPU use' line): a measure of the load
+    that other work put on the machine while this ran."""
+    if "cpu_use" not in df:
+        return []
+    c = df[(df.phase == "total") & (df.threads == 1) & df.code.str.startswith("lammps")].cpu_use.dropna()
+    if c.empty:
+        return []
+    return [f"LAMMPS's one-thread runs had {100 * c.median():.0f} % of a core (median; {100 * c.min():.0f}–{100 * c.max():.0f} %, "
+            f"its own '% CPU use' line, CPU time over wall time over {len(c)} runs): the rest of the wall time they "
+            "waited for the core.", ""]
+
+
 def markdown(df, med, ref, provenance, versions):
     """The whole bench_peers.md."""
     prov = provenance or {}
@@ -183,6 +198,7 @@ def markdown(df, med, ref, provenance, versions):
              "then the paired ratios. Produced by scripts/run_peers.sh; every sample in bench_peers.json.", ""]
     if versions.get("note"):
         lines += [versions["note"], ""]
+    lines += cpu_use_note(df)
     lines += [steps_note(df), "",
               f"Contact law: {versions.get('contact_law', 'the paper' + chr(39) + 's (physics.md section 2)')}.", ""]
     for threads in sorted(med.threads.unique()):
@@ -193,7 +209,8 @@ def markdown(df, med, ref, provenance, versions):
                       f"The threaded codes on {threads} threads: the suite's threaded variants (`demmat bench --threads`) and "
                       f"LAMMPS built here with `-sf omp -pk omp {threads}` (its OPENMP package: a style with an /omp version "
                       "runs threaded, any other as on one thread; docs/peers.md). Ratios to LAMMPS OPENMP at the same threads; "
-                      "† marks a run on fewer threads than asked (fast runs a bed of fewer than 3000 grains on one).", ""]
+                      "† marks a run on fewer threads than asked (fast runs a bed of fewer than 3000 grains on one). "
+                      f"OMP_WAIT_POLICY: {versions.get('omp_wait_policy', 'not recorded')}.", ""]
         for stage in STAGES:
             lines += stage_tables(df, med, ref, versions, stage, threads, ns)
         if threads > 1:

@@ -51,7 +51,7 @@ def figure7(rep, stats_of):
 def _paired_span(csv, code, stage="bed"):
     import pandas as pd
     df = pd.read_csv(csv)
-    x = df[(df.variant == code) & (df.stage == stage)]
+    x = df[(df.variant == code) & (df.stage == stage) & (df.threads == 1 if "threads" in df else True)]
     if x.empty:
         return None
     return x.paired_ratio.min(), x.paired_ratio.max(), int(x.particles.min()), int(x.particles.max())
@@ -59,6 +59,7 @@ def _paired_span(csv, code, stage="bed"):
 
 def lammps(rep, cpu_of):
     """fast (and every style where the full run has them) over LAMMPS, settled bed, paired ratios."""
+    import pandas as pd
     lines = []
     for folder in ("peers_fast", "peers_fast_xeon", "peers"):
         csv = rep.path(f"{folder}/bench_peers.csv")
@@ -70,8 +71,10 @@ def lammps(rep, cpu_of):
             if s:
                 parts.append(f"{code} {s[0]:.2f}–{s[1]:.2f}×")
         s = _paired_span(csv, "fast") or _paired_span(csv, "arrays")
+        built = "lammps_native" in set(pd.read_csv(csv).code)
+        peer = "the time of LAMMPS built for the CPU (-O3 -march=native)" if built else "the time of Debian's LAMMPS binary"
         if parts and s:
-            lines.append(f"- {', '.join(parts)} LAMMPS's time (settled bed, N = {s[2]}–{s[3]}, one core each, paired "
+            lines.append(f"- {', '.join(parts)} {peer} (settled bed, N = {s[2]}–{s[3]}, one core each, paired "
                          f"medians; {cpu_of(folder)}; {rep.link(folder + '/bench_peers.md')})")
     if not lines:
         return absent(rep, 1, "scripts/run_peers.sh")

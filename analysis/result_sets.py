@@ -32,8 +32,10 @@ SETS = {
     "peers": ("every style beside LAMMPS and LIGGGHTS; the physics cross-check", "scripts/run_peers.sh", CODE_ALL + ["peers"]),
     "peers_fast": ("fast beside LAMMPS, phase by phase", "scripts/run_peers.sh --bench-only --variants fast,fast_unordered --out results/peers_fast",
                    ["common", "variants/fast", "app", "peers"]),
-    "peers_fast_xeon": ("fast beside LAMMPS, phase by phase, second CPU", "the same with --out results/peers_fast_xeon",
-                        ["common", "variants/fast", "app", "peers"]),
+    "peers_fast_xeon": ("fast beside LAMMPS built for the CPU and Debian's binary, one core and two: fast's targets; second CPU",
+                        "OMP_WAIT_POLICY=PASSIVE scripts/run_peers.sh --bench-only --no-liggghts --variants fast,fast_unordered "
+                        "--n \"1000 4000 16000\" --threads \"1 2\" --repetitions 5 --out results/peers_fast_xeon",
+                        ["common", "variants/fast", "app", "peers", "scripts/build_lammps.sh"]),
     "peers_mindlin": ("fast and arrays beside LAMMPS with mindlin", "scripts/run_peers.sh --contact … --out results/peers_mindlin",
                       ["common", "variants/fast", "variants/arrays", "app", "peers"]),
     "peers_mindlin_sds": ("fast and arrays beside LAMMPS with mindlin + sds", "scripts/run_peers.sh --contact … --out results/peers_mindlin_sds",

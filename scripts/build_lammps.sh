@@ -74,7 +74,12 @@ echo "$SCRIPT: building LAMMPS $version ($flags; $packages) in $build" >&2
   -DBUILD_MPI=off -DBUILD_OMP=on -DBUILD_SHARED_LIBS=off \
   -DWITH_JPEG=off -DWITH_PNG=off -DWITH_FFMPEG=off -DWITH_GZIP=off \
   "${pkg_args[@]}" "${launcher[@]}" >/dev/null
-"${nice[@]}" cmake --build "$build" -j "$jobs" --target lmp >/dev/null
+# LAMMPS's own compiler output (its warnings among it) goes to a log, shown where the build fails.
+if ! "${nice[@]}" cmake --build "$build" -j "$jobs" --target lmp > "$cache/build.log" 2>&1; then
+  tail -n 30 "$cache/build.log" >&2
+  echo "$SCRIPT: the build of LAMMPS failed; its whole output is in $cache/build.log" >&2
+  exit 1
+fi
 [[ -x $lmp ]] || { echo "$SCRIPT: the build left no $lmp" >&2; exit 1; }
 echo "$stamp" > "$build/demmat-stamp"
 echo "$lmp"

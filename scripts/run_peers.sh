@@ -117,6 +117,7 @@ mkdir -p "$work" "$out"
     echo "  \"liggghts_package\": \"$(dpkg-query -W -f='${Version}' liggghts 2>/dev/null)\","
   fi
   echo "  \"contact_law\": \"${contact:-paper (physics.md section 2)}\","
+  echo "  \"omp_wait_policy\": \"${OMP_WAIT_POLICY:-the OpenMP runtime default}\","
   echo "  \"mpi\": \"none (one process per run; OMP_NUM_THREADS=1, more threads only where --threads asks)\""
   echo "}"
 } > "$work/versions.json"
