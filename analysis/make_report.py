@@ -215,6 +215,11 @@ def build(root, out, paper):
         section(rep, f"The physics beside LAMMPS with contact memory ({law})", [physics_law, f"{folder}/single_contacts.md"],
                 [(physics_law and physics_law.replace("physics_", "peers_physics_").replace(".md", ".png"), f"Physics cross-check, {law}")],
                 "the ensemble cross-check with a law of physics.md §9", f"scripts/run_peers.sh --contact \"{keys}\" --out results/{folder}")
+    # fast beside LAMMPS on each CPU that has a run: both LAMMPS builds named with their flags, fast's targets.
+    for folder in sorted(os.path.basename(f) for f in glob.glob(os.path.join(root, "peers_fast*"))):
+        section(rep, f"fast beside LAMMPS built for the CPU and Debian's binary ({folder})", [f"{folder}/bench_peers.md"],
+                [(f"{folder}/peers_us_per_particle_step.png", f"µs per particle-step against N ({folder})")],
+                "fast's targets beside LAMMPS", f"scripts/run_peers.sh --bench-only --variants fast,fast_unordered --out results/{folder}")
     section(rep, "What contact memory costs each style", ["memory_cost/table.md"], [("memory_cost/memory_cost.png", "memory cost")],
             "the cost of contact memory per style", "scripts/run_memory_cost.sh")
     validation(rep)

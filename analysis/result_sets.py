@@ -77,8 +77,13 @@ def _git(repo, *args):
 COMMENT = re.compile(r"\s*(//|#|\*|/\*|!|\{|\(\*|$)")  # C++, CMake/shell/Python, Fortran, Pascal, blank
 
 
-@functools.lru_cache(maxsize=None)
 def _last_change(repo, paths, limit):
+    head = _git(repo, "rev-parse", "HEAD")
+    return _last_change_at(repo, head.stdout.strip() if head else None, paths, limit)
+
+
+@functools.lru_cache(maxsize=None)
+def _last_change_at(repo, head, paths, limit):  # keyed by HEAD: a new commit is a new question
     return last_change(repo, list(paths), limit)
 
 

@@ -233,8 +233,10 @@ class PeersBench(unittest.TestCase):
     of each code's phases."""
 
     def setUp(self):
+        import peers_bench
         import plot_peers
         self.peers = plot_peers
+        self.read_peer_log = peers_bench.read_peer_log
         self.work = tempfile.mkdtemp()
         self.addCleanup(shutil.rmtree, self.work)
 
@@ -246,7 +248,7 @@ class PeersBench(unittest.TestCase):
 
     def test_the_timed_loop_is_the_last_and_the_rest_is_what_pair_and_neigh_leave(self):
         for text, pair, neigh in ((LAMMPS_LOG, 2.2243, 0.046851), (LIGGGHTS_LOG, 2.17117, 0.0911109)):
-            steps, particles, sec = self.peers.read_peer_log(self.log("x.out", text))
+            steps, particles, sec = self.read_peer_log(self.log("x.out", text))
             total = 3.16708 if text is LAMMPS_LOG else 2.75224
             self.assertEqual((steps, particles), (200, 64000))
             self.assertAlmostEqual(sec["total"], total / 200, places=15)
@@ -256,7 +258,7 @@ class PeersBench(unittest.TestCase):
 
     def test_a_failed_run_is_named(self):
         with self.assertRaises(SystemExit) as e:
-            self.peers.read_peer_log(self.log("lammps_n1000_bed_r0.out", "ERROR: Cannot open file bed.data\n"))
+            self.read_peer_log(self.log("lammps_n1000_bed_r0.out", "ERROR: Cannot open file bed.data\n"))
         self.assertIn("lammps_n1000_bed_r0.out", str(e.exception))
 
     def test_phase_table_sums_predict_and_correct_per_repetition_then_takes_the_median(self):
@@ -274,12 +276,12 @@ class PeersBench(unittest.TestCase):
         self.peers.write_bench(pd.DataFrame(rows), {}, versions, self.work, os.path.join(self.work, "f.png"))
         text = open(os.path.join(self.work, "bench_peers.md")).read()
         cells = {line.split("|")[1].strip() + "/" + line.split("|")[2].strip().split(" ")[0]: line.split("|")[3].strip()
-                 for line in text.split("## Where the time goes")[1].splitlines() if line.startswith("| fast") or line.startswith("| lammps")}
+                 for line in text.split("## Where the time goes")[1].splitlines() if line.startswith("| fast") or line.startswith("| LAMMPS")}
         # per repetition 0.011, 0.023, 0.032 µs per particle-step: the median is 0.023 (not 0.02 + 0.002)
         self.assertEqual(cells["fast/predict"], "0.0230")
         self.assertEqual(cells["fast/forces"], "0.0500")
-        self.assertEqual(cells["lammps/Pair"], "0.0800")
-        self.assertEqual(cells["lammps/rest"], "0.0200")
+        self.assertEqual(cells["LAMMPS Debian (-g -O2, baseline x86-64)/Pair"], "0.0800")
+        self.assertEqual(cells["LAMMPS Debian (-g -O2, baseline x86-64)/rest"], "0.0200")
         ratio = [line for line in text.splitlines() if line.startswith("| fast |")][0].split("|")[2].strip()
         self.assertEqual(ratio, f"{(2e-5 + 3e-6 + 5e-5) / 1.01e-4:.2f}")  # totals only in the ratio table
 
@@ -312,7 +314,7 @@ class PeersBench(unittest.TestCase):
                                  "repetition": 0, "steps": k, "phase": "total", "seconds_per_step": 1e-4})
             self.peers.write_bench(pd.DataFrame(rows), {}, {"lammps": "test"}, self.work, os.path.join(self.work, "f.png"))
             with open(os.path.join(self.work, "bench_peers.md")) as f:
-                return f.read().split("## ")[1]  # the loose grid's table
+                return f.read().split("### loose grid")[1].split("###")[0]  # the loose grid's table
 
         text = table({1000: 1000, 4000: 250})
         row = [line for line in text.splitlines() if line.startswith("| *timed steps*")]
@@ -325,6 +327,77 @@ class PeersBench(unittest.TestCase):
             whole = f.read()
         self.assertIn("the same timed steps at every N", whole)
         self.assertNotIn("differ from one N to another", whole)
+
+    def sample(self, code, variant, threads, stage, rep, seconds, n=1000, ran_on=None):
+        return {"code": code, "variant": variant, "threads": threads, "ran_on": ran_on or threads, "particles": n,
+                "stage": stage, "repetition": rep, "steps": 1000, "phase": "total", "seconds_per_step": seconds}
+
+    def bench_md(self, rows, versions):
+        import pandas as pd
+        self.peers.write_bench(pd.DataFrame(rows), {"cpu": "test CPU"}, versions, self.work, os.path.join(self.work, "f.png"))
+        with open(os.path.join(self.work, "bench_peers.md")) as f:
+            return f.read()
+
+    NATIVE = {"lammps": "29 Sep 2021", "lammps_package": "1-2+b2", "lammps_native": "29 Sep 2021",
+              "lammps_native_flags": "-O3 -march=native",
+              "lammps_native_build": "source lammps 1-2; flags -O3 -march=native; packages GRANULAR OPENMP"}
+
+    def test_both_lammps_builds_are_rows_named_with_their_flags_and_the_native_one_is_the_reference(self):
+        rows = []
+        for rep in range(3):
+            rows += [self.sample("suite", "fast", 1, "bed", rep, 4e-5), self.sample("lammps_native", "lammps_native", 1, "bed", rep, 1e-4),
+                     self.sample("lammps", "lammps", 1, "bed", rep, 1.5e-4)]
+        text = self.bench_md(rows, self.NATIVE)
+        self.assertIn("relative to LAMMPS -O3 -march=native", text.splitlines()[0])
+        self.assertIn("packages GRANULAR OPENMP", text)          # the build's stamp, in the header
+        self.assertIn("Debian's binary of LAMMPS 29 Sep 2021 (package 1-2+b2; -g -O2, baseline x86-64", text)
+        table = text.split("### settled bed")[1].split("Paired")[0]
+        self.assertIn("| fast | 0.40 |", table)
+        self.assertIn("| LAMMPS -O3 -march=native | 1.00 |", table)
+        self.assertIn("| LAMMPS Debian (-g -O2, baseline x86-64) | 1.50 |", table)
+        self.assertIn("| *LAMMPS -O3 -march=native: µs per particle-step* | 0.100 |", table)
+        with open(os.path.join(self.work, "bench_peers.json")) as f:
+            self.assertEqual(json.load(f)["reference"], "lammps_native")
+
+    def test_two_threads_are_taken_against_lammps_openmp_on_two_and_a_run_on_fewer_is_marked(self):
+        rows = []
+        for rep in range(3):
+            rows += [self.sample("suite", "fast", 1, "bed", rep, 4e-5), self.sample("lammps_native", "lammps_native", 1, "bed", rep, 1e-4),
+                     self.sample("suite", "fast", 2, "bed", rep, 3e-5, ran_on=1),
+                     self.sample("lammps_native", "lammps_native", 2, "bed", rep, 6e-5)]
+        text = self.bench_md(rows, self.NATIVE)
+        two = text.split("## 2 threads")[1]
+        self.assertIn("| fast, 2 threads | 0.50 † |", two)   # against LAMMPS on two threads (6e-5), not on one
+        self.assertIn("| LAMMPS -O3 -march=native, OPENMP 2 threads | 1.00 |", two)
+        self.assertIn("-sf omp -pk omp 2", two)
+        speed_up = two.split("### From one thread to 2")[1]
+        self.assertIn("| fast, 2 threads | settled bed | 1.33 |", speed_up)
+        self.assertIn("| LAMMPS -O3 -march=native, OPENMP 2 threads | settled bed | 1.67 |", speed_up)
+
+    def test_targets_are_each_repetitions_ratio_against_its_limit(self):
+        rows = []
+        # fast 0.4 of LAMMPS (met), 1.2 of fast_unordered (missed by 9 %), the loose grid 2.0 of the bed
+        # (missed by 33 %), on two threads 0.9 of LAMMPS OPENMP (met).
+        for rep in range(3):
+            for stage, scale in (("bed", 1.0), ("loose", 2.0)):
+                rows += [self.sample("suite", "fast", 1, stage, rep, 4e-5 * scale),
+                         self.sample("suite", "fast_unordered", 1, stage, rep, 4e-5 * scale / 1.2),
+                         self.sample("lammps_native", "lammps_native", 1, stage, rep, 1e-4),
+                         self.sample("suite", "fast", 2, stage, rep, 2.7e-5), self.sample("lammps_native", "lammps_native", 2, stage, rep, 3e-5)]
+        targets = self.bench_md(rows, self.NATIVE).split("## fast's targets")[1].split("## ")[0]
+        self.assertIn("| fast ≤ 0.5× LAMMPS -O3 -march=native, one core | settled bed | 0.40 met |", targets)
+        self.assertIn("| fast ≤ 1.10× fast_unordered, one core | settled bed | 1.20 missed by 9 % |", targets)
+        self.assertIn("| fast's loose grid ≤ 1.5× its settled bed, one core | per particle-step | 2.00 missed by 33 % |", targets)
+        self.assertIn("| fast on 2 threads faster than LAMMPS -O3 -march=native, OPENMP 2 threads | settled bed | 0.90 met |", targets)
+        self.assertNotIn("compression", targets)   # no row for a stage that was not run
+
+    def test_work_folder_logs_name_the_build_and_the_threads(self):
+        import peers_bench
+        for name in ("lammps_native_t2_n64000_bed_r1.out", "lammps_t1_n64000_bed_r0.out", "lammps_n64000_compression_r2.out"):
+            self.log(name, LAMMPS_LOG)
+        df, _ = peers_bench.read_work(self.work)
+        got = sorted(set(zip(df.code, df.threads, df.stage, df.repetition)))
+        self.assertEqual(got, [("lammps", 1, "bed", 0), ("lammps", 1, "compression", 2), ("lammps_native", 2, "bed", 1)])
 
 
 class PeerContacts(unittest.TestCase):
@@ -445,6 +518,27 @@ class Report(unittest.TestCase):
         finally:
             shutil.rmtree(root)
 
+
+    def test_fast_beside_both_lammps_builds_is_a_section_naming_their_flags(self):
+        import pandas as pd
+        import plot_peers
+        root = tempfile.mkdtemp()
+        self.addCleanup(shutil.rmtree, root)
+        rows = [{"code": code, "variant": code if code != "suite" else "fast", "threads": 1, "particles": 1000, "stage": "bed",
+                 "repetition": 0, "steps": 1000, "phase": "total", "seconds_per_step": t}
+                for code, t in (("suite", 4e-5), ("lammps_native", 1e-4), ("lammps", 1.2e-4))]
+        out = os.path.join(root, "peers_fast_xeon")
+        plot_peers.write_bench(pd.DataFrame(rows), {"cpu": "test CPU"}, PeersBench.NATIVE, out,
+                               os.path.join(out, "peers_us_per_particle_step.png"))
+        report = os.path.join(root, "REPORT.md")
+        done = subprocess.run([sys.executable, os.path.join(ANALYSIS, "make_report.py"), "--results", root, "--out", report],
+                              capture_output=True, text=True, timeout=120)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        with open(report) as f:
+            text = f.read().split("## fast beside LAMMPS built for the CPU and Debian's binary (peers_fast_xeon)")[1]
+        self.assertIn("| LAMMPS -O3 -march=native | 1.00 |", text)
+        self.assertIn("| LAMMPS Debian (-g -O2, baseline x86-64) | 1.20 |", text)
+        self.assertIn("peers_fast_xeon/peers_us_per_particle_step.png", text)
 
     def test_validation_summary_counts_each_verdict(self):
         """Chung & Ooi's summary: passes over judged values, and the paper's law's expected differences apart."""
