@@ -103,7 +103,7 @@ namespace detail {
 // The branches of the law below are selects (`cond ? a : b`, lane by lane for a pack of lanes,
 // lanes.hpp), so one text serves a scalar T and a pack; S is T's scalar, the parameters' type.
 template <class T>
-inline Vec3<T> select(const auto& cond, const Vec3<T>& a, const Vec3<T>& b)
+DEMMAT_HD inline Vec3<T> select(const auto& cond, const Vec3<T>& a, const Vec3<T>& b)
 {
     return {cond ? a.x : b.x, cond ? a.y : b.y, cond ? a.z : b.z};
 }
@@ -111,7 +111,7 @@ inline Vec3<T> select(const auto& cond, const Vec3<T>& a, const Vec3<T>& b)
 // A stretch turned into the current tangent plane with its length kept (§9 step 1), when its normal
 // part matters: |ξ·n|·k > 10⁻¹⁰·cap; ξ ← 0 when its projection vanishes.
 template <class T, class S>
-inline Vec3<T> to_tangent_plane(const Vec3<T>& xi, const Vec3<T>& n, T k, T cap)
+DEMMAT_HD inline Vec3<T> to_tangent_plane(const Vec3<T>& xi, const Vec3<T>& n, T k, T cap)
 {
     const T zero{};
     const T xn = dot(xi, n);
@@ -129,7 +129,7 @@ inline Vec3<T> to_tangent_plane(const Vec3<T>& xi, const Vec3<T>& n, T k, T cap)
 // trial force −k·ξ − η·vel, capped at `cap` with ξ set back to the stretch of the capped force (the
 // contact slides). Returns the force; `advance` false evaluates without moving the stretch on (t = 0).
 template <class T, class S>
-inline Vec3<T> spring(Vec3<T>& xi, const Vec3<T>& n, const Vec3<T>& vel, T k, T eta, T cap, S dt, bool advance)
+DEMMAT_HD inline Vec3<T> spring(Vec3<T>& xi, const Vec3<T>& n, const Vec3<T>& vel, T k, T eta, T cap, S dt, bool advance)
 {
     const T zero{};
     xi = to_tangent_plane<T, S>(xi, n, k, cap);
@@ -150,7 +150,7 @@ inline Vec3<T> spring(Vec3<T>& xi, const Vec3<T>& n, const Vec3<T>& vel, T k, T 
 // and 8·G*. Writes the force on i, its tangential part and the rolling torque on i (the partner's is
 // minus it); advances the stretches in `s`.
 template <class M, class T, class S>
-inline void memory_law(const Vec3<T>& n, T h, const Vec3<T>& u, const Vec3<T>& spin, T rstar, T mstar, S hertz, S shear8,
+DEMMAT_HD inline void memory_law(const Vec3<T>& n, T h, const Vec3<T>& u, const Vec3<T>& spin, T rstar, T mstar, S hertz, S shear8,
                        const ContactParams<S>& p, const MemoryParams<S>& q, Stretch<T>& s, bool advance, Vec3<T>& f_i,
                        Vec3<T>& f_t, Vec3<T>& t_roll)
 {
@@ -181,7 +181,7 @@ inline void memory_law(const Vec3<T>& n, T h, const Vec3<T>& u, const Vec3<T>& s
 
 // The pair law once h is known (in every lane whose result is kept).
 template <class M, class T, class S>
-inline void pair_memory_law(const Vec3<T>& dx, T d, T h, const Vec3<T>& vi, const Vec3<T>& vj, const Vec3<T>& wi, const Vec3<T>& wj,
+DEMMAT_HD inline void pair_memory_law(const Vec3<T>& dx, T d, T h, const Vec3<T>& vi, const Vec3<T>& vj, const Vec3<T>& wi, const Vec3<T>& wj,
                             T ri, T rj, T mi, T mj, const ContactParams<S>& p, const MemoryParams<S>& q, Stretch<T>& s, bool advance,
                             ContactForce<T>& out)
 {
@@ -206,7 +206,7 @@ inline void pair_memory_law(const Vec3<T>& dx, T d, T h, const Vec3<T>& vi, cons
 
 // The wall law once h is known.
 template <class M, class T, class S>
-inline void wall_memory_law(T h, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T mi, const Vec3<T>& normal, const Vec3<T>& vw,
+DEMMAT_HD inline void wall_memory_law(T h, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T mi, const Vec3<T>& normal, const Vec3<T>& vw,
                             const ContactParams<S>& p, const MemoryParams<S>& q, Stretch<T>& s, bool advance, ContactForce<T>& out)
 {
     static_assert(M::rotation && M::friction && M::moving_walls, "a §9 law runs on the full model (with_law_model)");
@@ -226,7 +226,7 @@ inline void wall_memory_law(T h, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T m
 // Particle–particle contact under a §9 law, i < j by id: as particle_contact (contact_law.hpp), and the
 // pair's stretches `s` carried in and out. Returns false (and leaves `s` alone) when h <= 0.
 template <class M, class T>
-inline bool particle_contact_memory(const Vec3<T>& xi, const Vec3<T>& xj, const Vec3<T>& vi, const Vec3<T>& vj,
+DEMMAT_HD inline bool particle_contact_memory(const Vec3<T>& xi, const Vec3<T>& xj, const Vec3<T>& vi, const Vec3<T>& vj,
                                     const Vec3<T>& wi, const Vec3<T>& wj, T ri, T rj, T mi, T mj, const ContactParams<T>& p,
                                     const MemoryParams<T>& q, Stretch<T>& s, bool advance, ContactForce<T>& out)
 {
@@ -240,7 +240,7 @@ inline bool particle_contact_memory(const Vec3<T>& xi, const Vec3<T>& xj, const 
 
 // Particle–wall contact under a §9 law: as wall_contact (contact_law.hpp), with the contact's stretches.
 template <class M, class T>
-inline bool wall_contact_memory(const Vec3<T>& xi, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T mi, const Vec3<T>& point,
+DEMMAT_HD inline bool wall_contact_memory(const Vec3<T>& xi, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T mi, const Vec3<T>& point,
                                 const Vec3<T>& normal, const Vec3<T>& vw, const ContactParams<T>& p, const MemoryParams<T>& q,
                                 Stretch<T>& s, bool advance, ContactForce<T>& out)
 {
