@@ -132,7 +132,28 @@ def accuracy(rep):
         picks.append(f"{m.group(1)}: {best[1]} ({best[0]:g} CPU s per simulated s)" if best else f"{m.group(1)}: none")
     label(rep, 3, "the cheapest integrator and precision within each tolerance on every two-body error — "
           + "; ".join(picks) + f" ({rep.link('accuracy/recommendation.md')}).", folder="accuracy")
+    memory_laws(rep)
     rep.add("")
+
+
+def memory_laws(rep):
+    """The laws with memory: per law, the tightest target met and the cheapest way to meet it."""
+    rel = "accuracy/memory/memory_recommendation.md"
+    if not os.path.exists(rep.path(rel)):
+        return
+    with open(rep.path(rel)) as f:
+        rows = [[c.strip() for c in l.strip().strip("|").split("|")] for l in f if l.startswith("| ")]
+    best = {}
+    for r in rows[1:]:
+        try:
+            target = float(r[1])
+        except (IndexError, ValueError):
+            continue
+        if r[2] != "not met" and (r[0] not in best or target < best[r[0]][0]):
+            best[r[0]] = (target, r[2])
+    if best:
+        rep.add("With memory, the tightest error met on Chung & Ooi tests 4 and 8 and its cheapest update, integrator "
+                "and Δt: " + "; ".join(f"{law} {t:g}: {cell}" for law, (t, cell) in best.items()) + f" ({rep.link(rel)}).")
 
 
 def validation(rep):
