@@ -42,6 +42,8 @@ SETS = {
     "memory_cost": ("what contact memory costs each style", "scripts/run_memory_cost.sh", CODE_ALL),
     "features": ("what each model feature costs", "scripts/run_features.sh", CODE_ALL + ["bench"]),
     "accuracy": ("error against CPU time: integrator × precision × Δt", "scripts/run_accuracy.sh", CODE_ARRAYS + ["bench"]),
+    "accuracy/memory": ("error against CPU time of the laws with memory", "scripts/run_accuracy.sh --memory",
+                        CODE_ARRAYS + ["bench"]),
     "stability": ("the largest stable Δt", "scripts/run_stability.sh", CODE_ARRAYS + ["bench"]),
     "validation": ("Chung & Ooi tests 1–8", "scripts/run_validation.sh", CODE_ALL + ["analysis/validation_reference.py"]),
     "mpi": ("the mpi variant beside fast and LAMMPS", "scripts/run_mpi_bench.sh", ["common", "variants/mpi", "variants/fast", "app"]),
@@ -53,8 +55,9 @@ def describe(root, folder):
     """The set's provenance from its result files: commits (full), CPUs, compilers, dates."""
     prov = {"commits": set(), "cpus": set(), "compilers": set(), "dates": set(), "dirty": False}
     for path in sorted(glob.glob(os.path.join(root, folder, "**", "*.json"), recursive=True)):
-        if os.path.basename(path) == "set.json":
-            continue
+        inner = os.path.relpath(os.path.dirname(path), root).replace(os.sep, "/")
+        if os.path.basename(path) == "set.json" or (inner != folder and inner in SETS):
+            continue  # a set's own file, or a set of its own inside this one
         try:
             p = load(path).provenance
         except (ValueError, KeyError):
