@@ -21,24 +21,27 @@ from results import load
 REPO = os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir)
 
 # folder: (question, command, the code it measured). The code paths are what a change must not postdate.
-CODE_ALL = ["common", "variants", "app"]
-CODE_ARRAYS = ["common", ":(exclude)common/include/demmat/soa", "variants/arrays"]  # fast's engine aside
+# The layers below the variants (common/ held them all before the layering; its history still counts).
+BELOW = ["common", "core", "harness"]
+CODE_ALL = BELOW + ["engines", "variants", "app"]
+LANE = BELOW + ["engines/lane_engine", "engines/columns"]  # fast and the mpi ranks, beside arrays' columns
+CODE_ARRAYS = BELOW + [":(exclude)common/include/demmat/soa", "engines/columns", "variants/arrays"]
 SETS = {
     "main": ("Figure 7: each style phase by phase", "scripts/run_main.sh", CODE_ALL),
     "sweep_short": ("Figure 4, cell size, scaling, where the time goes", "scripts/run_main.sh --sweep", CODE_ALL),
     "sweep_million": ("the same at 10⁶ loose grains", "scripts/run_main.sh --full", CODE_ALL),
-    "fast": ("fast at 1 and 2 threads, 10³–10⁶ grains", "scripts/bench_fast.sh", ["common", "variants/fast", "variants/arrays"]),
+    "fast": ("fast at 1 and 2 threads, 10³–10⁶ grains", "scripts/bench_fast.sh", LANE + ["variants/fast", "variants/arrays"]),
     "fast_xeon": ("fast at 1 and 2 threads, 10³–6.4·10⁴ grains, second CPU", "scripts/bench_fast.sh --out results/fast_xeon",
-                  ["common", "variants/fast", "variants/arrays"]),
+                  LANE + ["variants/fast", "variants/arrays"]),
     "peers": ("every style beside LAMMPS and LIGGGHTS; the physics cross-check", "scripts/run_peers.sh", CODE_ALL + ["peers"]),
     "peers_fast": ("fast beside LAMMPS, phase by phase", "scripts/run_peers.sh --bench-only --variants fast,fast_unordered --out results/peers_fast",
-                   ["common", "variants/fast", "app", "peers"]),
+                   LANE + ["variants/fast", "app", "peers"]),
     "peers_fast_xeon": ("fast beside LAMMPS, phase by phase, second CPU", "the same with --out results/peers_fast_xeon",
-                        ["common", "variants/fast", "app", "peers"]),
+                        LANE + ["variants/fast", "app", "peers"]),
     "peers_mindlin": ("fast and arrays beside LAMMPS with mindlin", "scripts/run_peers.sh --contact … --out results/peers_mindlin",
-                      ["common", "variants/fast", "variants/arrays", "app", "peers"]),
+                      LANE + ["variants/fast", "variants/arrays", "app", "peers"]),
     "peers_mindlin_sds": ("fast and arrays beside LAMMPS with mindlin + sds", "scripts/run_peers.sh --contact … --out results/peers_mindlin_sds",
-                          ["common", "variants/fast", "variants/arrays", "app", "peers"]),
+                          LANE + ["variants/fast", "variants/arrays", "app", "peers"]),
     "memory_cost": ("what contact memory costs each style", "scripts/run_memory_cost.sh", CODE_ALL),
     "features": ("what each model feature costs", "scripts/run_features.sh", CODE_ALL + ["bench"]),
     "accuracy": ("error against CPU time: integrator × precision × Δt", "scripts/run_accuracy.sh", CODE_ARRAYS + ["bench"]),
@@ -46,8 +49,8 @@ SETS = {
                         CODE_ARRAYS + ["bench"]),
     "stability": ("the largest stable Δt", "scripts/run_stability.sh", CODE_ARRAYS + ["bench"]),
     "validation": ("Chung & Ooi tests 1–8", "scripts/run_validation.sh", CODE_ALL + ["analysis/validation_reference.py"]),
-    "mpi": ("the mpi variant beside fast and LAMMPS", "scripts/run_mpi_bench.sh", ["common", "variants/mpi", "variants/fast", "app"]),
-    "gpu": ("the cuda variant on a GPU", "scripts/device_check.sh", ["common", "variants/cuda", "variants/fast", "app"]),
+    "mpi": ("the mpi variant beside fast and LAMMPS", "scripts/run_mpi_bench.sh", LANE + ["variants/mpi", "variants/fast", "app"]),
+    "gpu": ("the cuda variant on a GPU", "scripts/device_check.sh", LANE + ["variants/cuda", "variants/fast", "app"]),
 }
 
 
