@@ -19,8 +19,15 @@ ANSWERS = (
 )
 
 
-def label(rep, k, text="", item=False):
-    rep.add(("- " if item else "") + f"**{ANSWERS[k]}**" + (f": {text}" if text else ""))
+def caveat(rep, folder):
+    """' *(set: why it is not current)*' for a set that is not current, else ''."""
+    why = getattr(rep, "caveats", {}).get(folder)
+    return f" *({folder}: {why})*" if why else ""
+
+
+def label(rep, k, text="", item=False, folder=None):
+    rep.add(("- " if item else "") + f"**{ANSWERS[k]}**" + (f": {text}" if text else "")
+            + (caveat(rep, folder) if folder else ""))
 
 
 def absent(rep, k, script):
@@ -36,7 +43,7 @@ def figure7(rep, stats_of):
     res, stats, names = stats_of(files[-1])
     n = res.meta["scene"]["particles"]
     label(rep, 0, f"the compression stage of {n} grains, median of {res.meta['repetitions']} interleaved repetitions; "
-          f"details in [Figure 7](#figure-7-per-phase-cpu-time-per-variant-against-the-paper).")
+          f"details in [Figure 7](#figure-7-per-phase-cpu-time-per-variant-against-the-paper).", folder="main")
     rep.add("", "| variant | µs per step | × arrays | search + forces | µs per particle-step |", "|---|---:|---:|---:|---:|")
     for v in names:
         sub = stats[stats.variant == v].set_index("phase")
@@ -75,7 +82,8 @@ def lammps(rep, cpu_of):
         peer = "the time of LAMMPS built for the CPU (-O3 -march=native)" if built else "the time of Debian's LAMMPS binary"
         if parts and s:
             lines.append(f"- {', '.join(parts)} {peer} (settled bed, N = {s[2]}–{s[3]}, one core each, paired "
-                         f"medians; {cpu_of(folder)}; {rep.link(folder + '/bench_peers.md')})")
+                         f"medians; {'' if caveat(rep, folder) else cpu_of(folder) + '; '}{rep.link(folder + '/bench_peers.md')})"
+                         + caveat(rep, folder))
     if not lines:
         return absent(rep, 1, "scripts/run_peers.sh")
     label(rep, 1)
@@ -92,7 +100,7 @@ def memory(rep):
     df = df[df.stage == "settled"]
     laws = [l for l in ("linear_history", "mindlin", "mindlin_sds") if l in set(df.law)]
     label(rep, 2, f"time and bytes over the style's own under the paper's law, settled bed; "
-          f"{rep.link('memory_cost/table.md')}.")
+          f"{rep.link('memory_cost/table.md')}.", folder="memory_cost")
     rep.add("", "| variant | " + " | ".join(f"time, {l}" for l in laws) + f" | bytes, {laws[-1]} |",
             "|---|" + "---:|" * (len(laws) + 1))
     for v, x in df.groupby("variant", sort=False):
@@ -126,8 +134,29 @@ def accuracy(rep):
                 best = (float(c.group(2)), f"{r[0].strip()} {r[1].strip()} at Δt = {c.group(1)}·t_c")
         picks.append(f"{m.group(1)}: {best[1]} ({best[0]:g} CPU s per simulated s)" if best else f"{m.group(1)}: none")
     label(rep, 3, "the cheapest integrator and precision within each tolerance on every two-body error — "
-          + "; ".join(picks) + f" ({rep.link('accuracy/recommendation.md')}).")
+          + "; ".join(picks) + f" ({rep.link('accuracy/recommendation.md')}).", folder="accuracy")
+    memory_laws(rep)
     rep.add("")
+
+
+def memory_laws(rep):
+    """The laws with memory: per law, the tightest target met and the cheapest way to meet it."""
+    rel = "accuracy/memory/memory_recommendation.md"
+    if not os.path.exists(rep.path(rel)):
+        return
+    with open(rep.path(rel)) as f:
+        rows = [[c.strip() for c in l.strip().strip("|").split("|")] for l in f if l.startswith("| ")]
+    best = {}
+    for r in rows[1:]:
+        try:
+            target = float(r[1])
+        except (IndexError, ValueError):
+            continue
+        if r[2] != "not met" and (r[0] not in best or target < best[r[0]][0]):
+            best[r[0]] = (target, r[2])
+    if best:
+        rep.add("With memory, the tightest error met on Chung & Ooi tests 4 and 8 and its cheapest update, integrator "
+                "and Δt: " + "; ".join(f"{law} {t:g}: {cell}" for law, (t, cell) in best.items()) + f" ({rep.link(rel)}).")
 
 
 def validation(rep):
@@ -139,7 +168,7 @@ def validation(rep):
     df = pd.read_csv(rep.path(rel))
     df = df[df["pass"].isin(["pass", "FAIL", "fail"])]
     label(rep, 4, f"judged values within tolerance, per law, over every variant, material and integrator "
-          f"({rep.link('validation/table.md')}).")
+          f"({rep.link('validation/table.md')}).", folder="validation")
     rep.add("")
     for test, t in df.groupby("test"):
         per_law = [f"{law} {int((x['pass'] == 'pass').sum())}/{len(x)}" for law, x in t.groupby("law")]
@@ -161,7 +190,7 @@ def mpi(rep):
         parts.append(f"takes {r2 / med['fast 2 threads']:.2f}× the time of fast on 2 threads")
     if r2 and "lammps np=2" in med:
         parts.append(f"{r2 / med['lammps np=2']:.2f}× that of LAMMPS `mpirun -np 2`")
-    label(rep, 5, ", ".join(parts) + f"; bit-identical to arrays at any R ({rep.link('mpi/bench_mpi.md')}).", item=True)
+    label(rep, 5, ", ".join(parts) + f"; bit-identical to arrays at any R ({rep.link('mpi/bench_mpi.md')}).", item=True, folder="mpi")
 
 
 def cuda(rep):
@@ -180,4 +209,4 @@ def cuda(rep):
     speed = ", ".join(f"{r[7].strip()} faster than fast on {r[4].strip()} thread(s)" for r in fast)
     label(rep, 6, f"{same} of {checks} scenes bit for bit against arrays on {gpu.group(1) if gpu else 'the GPU'}"
           + (f"; at N = {best[2].strip()} settled, {best[5].strip()} µs per particle-step, {speed}" if best else "")
-          + f" ({rep.link('gpu/summary.md')}).", item=True)
+          + f" ({rep.link('gpu/summary.md')}).", item=True, folder="gpu")

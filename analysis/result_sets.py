@@ -21,32 +21,38 @@ from results import load
 REPO = os.path.join(os.path.dirname(os.path.abspath(__file__)), os.pardir)
 
 # folder: (question, command, the code it measured). The code paths are what a change must not postdate.
-CODE_ALL = ["common", "variants", "app"]
+# The layers below the variants (common/ held them all before the layering; its history still counts).
+BELOW = ["common", "core", "harness"]
+CODE_ALL = BELOW + ["engines", "variants", "app"]
+LANE = BELOW + ["engines/lane_engine", "engines/columns"]  # fast and the mpi ranks, beside arrays' columns
+CODE_ARRAYS = BELOW + [":(exclude)common/include/demmat/soa", "engines/columns", "variants/arrays"]
 SETS = {
     "main": ("Figure 7: each style phase by phase", "scripts/run_main.sh", CODE_ALL),
     "sweep_short": ("Figure 4, cell size, scaling, where the time goes", "scripts/run_main.sh --sweep", CODE_ALL),
     "sweep_million": ("the same at 10⁶ loose grains", "scripts/run_main.sh --full", CODE_ALL),
-    "fast": ("fast at 1 and 2 threads, 10³–10⁶ grains", "scripts/bench_fast.sh", ["common", "variants/fast", "variants/arrays"]),
+    "fast": ("fast at 1 and 2 threads, 10³–10⁶ grains", "scripts/bench_fast.sh", LANE + ["variants/fast", "variants/arrays"]),
     "fast_xeon": ("fast at 1 and 2 threads, 10³–6.4·10⁴ grains, second CPU", "scripts/bench_fast.sh --out results/fast_xeon",
-                  ["common", "variants/fast", "variants/arrays"]),
+                  LANE + ["variants/fast", "variants/arrays"]),
     "peers": ("every style beside LAMMPS and LIGGGHTS; the physics cross-check", "scripts/run_peers.sh", CODE_ALL + ["peers"]),
     "peers_fast": ("fast beside LAMMPS, phase by phase", "scripts/run_peers.sh --bench-only --variants fast,fast_unordered --out results/peers_fast",
-                   ["common", "variants/fast", "app", "peers"]),
+                   LANE + ["variants/fast", "app", "peers"]),
     "peers_fast_xeon": ("fast beside LAMMPS built for the CPU and Debian's binary, one core and two: fast's targets; second CPU",
                         "OMP_WAIT_POLICY=PASSIVE scripts/run_peers.sh --bench-only --no-liggghts --variants fast,fast_unordered "
                         "--n \"1000 4000 16000\" --threads \"1 2\" --repetitions 5 --out results/peers_fast_xeon",
-                        ["common", "variants/fast", "app", "peers", "scripts/build_lammps.sh"]),
+                        LANE + ["variants/fast", "app", "peers", "scripts/build_lammps.sh"]),
     "peers_mindlin": ("fast and arrays beside LAMMPS with mindlin", "scripts/run_peers.sh --contact … --out results/peers_mindlin",
-                      ["common", "variants/fast", "variants/arrays", "app", "peers"]),
+                      LANE + ["variants/fast", "variants/arrays", "app", "peers"]),
     "peers_mindlin_sds": ("fast and arrays beside LAMMPS with mindlin + sds", "scripts/run_peers.sh --contact … --out results/peers_mindlin_sds",
-                          ["common", "variants/fast", "variants/arrays", "app", "peers"]),
+                          LANE + ["variants/fast", "variants/arrays", "app", "peers"]),
     "memory_cost": ("what contact memory costs each style", "scripts/run_memory_cost.sh", CODE_ALL),
     "features": ("what each model feature costs", "scripts/run_features.sh", CODE_ALL + ["bench"]),
-    "accuracy": ("error against CPU time: integrator × precision × Δt", "scripts/run_accuracy.sh", ["common", "variants/arrays", "bench"]),
-    "stability": ("the largest stable Δt", "scripts/run_stability.sh", ["common", "variants/arrays", "bench"]),
+    "accuracy": ("error against CPU time: integrator × precision × Δt", "scripts/run_accuracy.sh", CODE_ARRAYS + ["bench"]),
+    "accuracy/memory": ("error against CPU time of the laws with memory", "scripts/run_accuracy.sh --memory",
+                        CODE_ARRAYS + ["bench"]),
+    "stability": ("the largest stable Δt", "scripts/run_stability.sh", CODE_ARRAYS + ["bench"]),
     "validation": ("Chung & Ooi tests 1–8", "scripts/run_validation.sh", CODE_ALL + ["analysis/validation_reference.py"]),
-    "mpi": ("the mpi variant beside fast and LAMMPS", "scripts/run_mpi_bench.sh", ["common", "variants/mpi", "variants/fast", "app"]),
-    "gpu": ("the cuda variant on a GPU", "scripts/device_check.sh", ["common", "variants/cuda", "variants/fast", "app"]),
+    "mpi": ("the mpi variant beside fast and LAMMPS", "scripts/run_mpi_bench.sh", LANE + ["variants/mpi", "variants/fast", "app"]),
+    "gpu": ("the cuda variant on a GPU", "scripts/device_check.sh", LANE + ["variants/cuda", "variants/fast", "app"]),
 }
 
 
@@ -54,8 +60,9 @@ def describe(root, folder):
     """The set's provenance from its result files: commits (full), CPUs, compilers, dates."""
     prov = {"commits": set(), "cpus": set(), "compilers": set(), "dates": set(), "dirty": False}
     for path in sorted(glob.glob(os.path.join(root, folder, "**", "*.json"), recursive=True)):
-        if os.path.basename(path) == "set.json":
-            continue
+        inner = os.path.relpath(os.path.dirname(path), root).replace(os.sep, "/")
+        if os.path.basename(path) == "set.json" or (inner != folder and inner in SETS):
+            continue  # a set's own file, or a set of its own inside this one
         try:
             p = load(path).provenance
         except (ValueError, KeyError):
