@@ -3,7 +3,7 @@
 //
 // The law: pair_law and wall_law below are the one place where a model picks its law, the paper's
 // (contact_law.hpp) or a §9 law with the contact's stretches (contact_memory.hpp). A law added there under
-// a new model flag joins through LawOf; a new spring in Stretch joins through for_each_spring (one line).
+// a new model flag joins through LawOf; a new spring in Stretch joins through spring_at (one line).
 //
 // The memory: each pair is computed by both of its particles' threads (kernels.hpp, Forces), so each
 // side keeps its own copy of the pair's stretches in its own row and advances it: both threads evaluate
@@ -28,11 +28,15 @@ inline constexpr bool LawOf = M::restitution_damping || M::history || M::rolling
 // The springs a model carries per contact, in the order the rows store them.
 template <class M>
 inline constexpr std::uint32_t kSprings = std::uint32_t(M::history) + std::uint32_t(M::rolling);
-template <class M, class F>
-DEMMAT_HD inline void for_each_spring(Stretch<double>& s, F&& f)
+// Spring q < kSprings<M> of a contact: the tangential one first where the model carries it. An index,
+// not a callback: a lambda's call operator is host-only code to nvcc inside a host-device function.
+template <class M>
+DEMMAT_HD inline Vec3<double>& spring_at(Stretch<double>& s, std::uint32_t q)
 {
-    if constexpr (M::history) f(s.t);
-    if constexpr (M::rolling) f(s.r);
+    if constexpr (M::history) {
+        if (q == 0) return s.t;
+    }
+    return s.r;
 }
 
 // One set of rows: per slot, its live contacts' keys (partner id or wall index, ascending) and springs.
@@ -51,13 +55,13 @@ DEMMAT_HD inline void put_stretch(const StretchRows& r, std::uint32_t n, std::ui
                                   Stretch<double> st)
 {
     r.key[std::uint64_t(k) * n + s] = key;
-    std::uint64_t c = 0;
-    for_each_spring<M>(st, [&](const Vec3<double>& v) {
+    for (std::uint32_t q = 0; q < kSprings<M>; ++q) {
+        const Vec3<double>& v = spring_at<M>(st, q);
+        const std::uint64_t c = 3 * std::uint64_t(q);
         r.spring[((c + 0) * r.cap + k) * n + s] = v.x;
         r.spring[((c + 1) * r.cap + k) * n + s] = v.y;
         r.spring[((c + 2) * r.cap + k) * n + s] = v.z;
-        c += 3;
-    });
+    }
 }
 
 // Reads a row by ascending key: take(key) for keys in ascending order gives each one's stretches, zero
@@ -74,11 +78,11 @@ struct RowReader {
         Stretch<double> st{};
         while (k < count && r.key[std::uint64_t(k) * n + s] < key) ++k;
         if (k == count || r.key[std::uint64_t(k) * n + s] != key) return st;
-        std::uint64_t c = 0;
-        for_each_spring<M>(st, [&](Vec3<double>& v) {
-            v = {r.spring[((c + 0) * r.cap + k) * n + s], r.spring[((c + 1) * r.cap + k) * n + s], r.spring[((c + 2) * r.cap + k) * n + s]};
-            c += 3;
-        });
+        for (std::uint32_t q = 0; q < kSprings<M>; ++q) {
+            const std::uint64_t c = 3 * std::uint64_t(q);
+            spring_at<M>(st, q) = {r.spring[((c + 0) * r.cap + k) * n + s], r.spring[((c + 1) * r.cap + k) * n + s],
+                                   r.spring[((c + 2) * r.cap + k) * n + s]};
+        }
         return st;
     }
 };

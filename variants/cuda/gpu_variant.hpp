@@ -236,9 +236,10 @@ private:
             h.key[k * n + s] = key;
             Stretch<double> st{c.tangential, c.rolling};
             std::size_t comp = 0;
-            for_each_spring<M>(st, [&](const Vec3<double>& x) {
+            for (std::uint32_t q = 0; q < kSprings<M>; ++q) {
+                const Vec3<double>& x = spring_at<M>(st, q);
                 for (double value : {x.x, x.y, x.z}) h.spring[(comp++ * cap + k) * n + s] = value;
-            });
+            }
         };
         for (const ContactStretch& c : in) {  // pairs below a particle come before its own (i ascending)
             const auto i = std::uint32_t(c.i), j = std::uint32_t(c.partner);
@@ -268,9 +269,10 @@ private:
                 if (!wall && partner < id[s]) continue;  // the pair's other copy, in its lower particle's row
                 Stretch<double> st{};
                 std::size_t comp = 0;
-                for_each_spring<M>(st, [&](Vec3<double>& x) {
+                for (std::uint32_t q = 0; q < kSprings<M>; ++q) {
+                    Vec3<double>& x = spring_at<M>(st, q);
                     for (double* value : {&x.x, &x.y, &x.z}) *value = spring[(comp++ * r.cap + k) * n + s];
-                });
+                }
                 out.push_back({std::int64_t(id[s]), std::int64_t(partner), wall, st.t, st.r});
             }
     }
