@@ -31,6 +31,7 @@ const char* name(TangentialModel t)
     return "viscous";
 }
 const char* name(RollingModel r) { return r == RollingModel::sds ? "sds" : "none"; }
+const char* name(StretchUpdate u) { return u == StretchUpdate::trapezoidal ? "trapezoidal" : "first_order"; }
 
 namespace {
 
@@ -87,7 +88,8 @@ public:
     void close(const ContactModel& m) const
     {
         static const std::set<std::string> known = {"damping", "restitution", "tangential", "kt", "tangential_damping_ratio",
-                                                    "rolling", "kr", "rolling_damping", "rolling_friction"};
+                                                    "rolling", "kr", "rolling_damping", "rolling_friction",
+                                                    "stretch_update"};
         for (const auto& [key, _] : v_.as_table()) {
             if (used_.count(key)) continue;
             if (!known.count(key)) fail(fmt::format("unknown key '{}' in [contact]", printable(key)));
@@ -132,6 +134,7 @@ ContactModel parse_contact_model(const toml::value& v, const std::string& label)
         m.rolling_damping = t.non_negative("rolling_damping", "rolling = \"sds\"");
         m.rolling_friction = t.non_negative("rolling_friction", "rolling = \"sds\"");
     }
+    if (m.has_spring()) m.stretch_update = t.model("stretch_update", {StretchUpdate::first_order, StretchUpdate::trapezoidal});
     t.close(m);
     return m;
 }
@@ -147,6 +150,7 @@ std::string ContactModel::describe() const
     s += fmt::format(", rolling {}", name(rolling));
     if (rolling == RollingModel::sds)
         s += fmt::format(" (kr = {} N/m, rolling_damping = {} N·s/m, rolling_friction = {})", kr, rolling_damping, rolling_friction);
+    if (stretch_update != StretchUpdate::first_order) s += fmt::format(", stretch update {}", name(stretch_update));
     return s;
 }
 
@@ -162,14 +166,17 @@ std::string ContactModel::toml() const
     o += fmt::format("rolling = \"{}\"\n", name(rolling));
     if (rolling == RollingModel::sds)
         o += fmt::format("kr = {}\nrolling_damping = {}\nrolling_friction = {}\n", kr, rolling_damping, rolling_friction);
+    if (stretch_update != StretchUpdate::first_order) o += fmt::format("stretch_update = \"{}\"\n", name(stretch_update));
     return o;
 }
 
 std::vector<double> ContactModel::fingerprint_values() const
 {
     if (is_paper()) return {};
-    return {double(int(damping)), restitution, double(int(tangential)), kt, tangential_damping_ratio, double(int(rolling)), kr,
-            rolling_damping, rolling_friction};
+    std::vector<double> v{double(int(damping)), restitution, double(int(tangential)), kt, tangential_damping_ratio, double(int(rolling)),
+                          kr, rolling_damping, rolling_friction};
+    if (stretch_update != StretchUpdate::first_order) v.push_back(double(int(stretch_update)));  // older fingerprints unchanged
+    return v;
 }
 
 ContactModel contact_model_from_options(const std::vector<std::string>& key_values)
