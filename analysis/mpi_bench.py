@@ -5,7 +5,7 @@ step per rank (demmat_mpi run on the dense bed's lattice).
 Writes, in --out:
   bench_mpi.json   medians, every sample, the provenance of the suite's runs, the peers' versions
   bench_mpi.csv    one row per (N, configuration): median, min, max µs per particle-step
-  bench_mpi.md     the comparison and the issue's targets, each said to be met or not
+  bench_mpi.md     the comparison and its targets (listed in docs/scaling.md), each said to be met or not
   halo_mpi.csv     one row per (N, R): particles, ghosts, messages and bytes per step per rank (mean, max)
   halo_mpi.md      the same as a table
   imbalance_mpi.csv, .md  particles per rank (max/mean at the end, the most a rank held/mean) of the static

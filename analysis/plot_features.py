@@ -23,8 +23,8 @@ import pandas as pd  # noqa: E402
 from atomic_io import atomic_write, write_text  # noqa: E402
 from results import PHASES, footer, load, save_figure, wide  # noqa: E402
 
-# The GPU study of this group's code the issue quotes: over normal forces alone, history-dependent
-# friction +38 %, torques +4 %.
+# What a GPU study of this group's code measured over normal forces alone: history-dependent
+# friction +38 %, torques +4 %. The table sets the suite's feature costs beside them.
 GPU_STUDY = {"friction": 0.38, "torques": 0.04}
 
 
@@ -99,7 +99,7 @@ def markdown(t, prov):
                 f"{pct(r.full_over_specialised)} | {r.contacts_per_particle:.2f} |")
         lines.append("")
     lines += [
-        "For comparison, the GPU study of this group's code quoted in issue 10: over normal forces alone, "
+        "For comparison, a GPU study of this group's code (its figures in analysis/plot_features.py, GPU_STUDY): over normal forces alone, "
         f"history-dependent friction {pct(GPU_STUDY['friction'])} and torques {pct(GPU_STUDY['torques'])}. "
         "Here friction has no history (viscous-regularised Coulomb, physics.md §2) and comes with rotation "
         "(torques and the rotational Gear state) in one level, since the model set instantiates them together.",

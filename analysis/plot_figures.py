@@ -281,7 +281,7 @@ def where(df, prov, callgrind, out, figs, suffix):
                   f"separate passes moves {sum(GEAR_SEPARATE_DOUBLES.values()) * 8} B (predict {GEAR_SEPARATE_DOUBLES['predict'] * 8}, "
                   f"correct {GEAR_SEPARATE_DOUBLES['correct'] * 8}); fast runs its corrector fused into the next step's predictor, "
                   "so its predict holds both, and with them Newton's law, the displacement check, the kernel's records and the "
-                  "wall candidates (docs/variants.md, \"fast\"). Below the bound means the arrays still sat in cache (small N)."]
+                  "wall candidates (docs/variants/engine.md). Below the bound means the arrays still sat in cache (small N)."]
     if callgrind:
         lines += ["", "Instructions per particle-step (valgrind --tool=callgrind, repeatable whatever the machine's load):", "",
                   "| variant | scene | N | steps | predict | search | forces | correct | total | contacts/particle |", "|---|---|---|---|---|---|---|---|---|---|"]

@@ -3,8 +3,9 @@
 
   plot_peers.py bench --work DIR --versions JSON --out DIR --figure PNG
       medians of the interleaved repetitions (suite variants from `demmat bench --json`, peers from the
-      logs of their timed runs), µs per particle-step against N, each variant's ratio to LAMMPS in the
-      same run, and where the time goes on the settled bed (each code's own phases).
+      logs of their timed runs), µs per particle-step against N, each variant's ratio to LAMMPS built
+      here at the same thread count, fast's targets and where the time goes on the settled bed
+      (peers_bench.py, peers_tables.py).
   plot_peers.py observables --dump FILE --scene TOML --code C --member M --stage S [--step-scale F] -o CSV
       per frame of a LAMMPS-style dump: kinetic energy, bed height, normal force on the x_max wall,
       computed the same way for every code.
@@ -19,7 +20,6 @@ import glob
 import json
 import math
 import os
-import re
 import sys
 import tomllib
 
@@ -31,217 +31,47 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 
 from atomic_io import write_text  # noqa: E402
-from results import footer, legend_outside, load, n_axis, save_figure, style, variant_key  # noqa: E402
-
-STAGES = ["loose", "bed", "compression"]
-STAGE_TITLE = {"loose": "loose grid (t = 0)", "bed": "settled bed", "compression": "compression stage"}
+from results import footer, legend_outside, load, n_axis, save_figure, style  # noqa: E402
+from peers_bench import STAGES, STAGE_TITLE, label as peer_label, read_work, replot_frame, summarise, write_json  # noqa: E402
+from peers_tables import markdown  # noqa: E402
 
 
 # ---- bench ----------------------------------------------------------------------------------------------
-SUITE_PHASES = ["predict", "search", "forces", "correct"]
-PEER_PHASES = ["pair", "neigh", "rest"]
-# The phases side by side (write_bench's table): what each code times, in the order of a step.
-PHASE_TITLE = {"predict": "predict + correct (Gear)", "search": "search (cells, lists)", "forces": "forces (pairs, walls)",
-               "pair": "Pair (pair style)", "neigh": "Neigh (lists)", "rest": "rest (fixes: integration, gravity, walls; other)"}
-PEER_LOG = re.compile(r"^(lammps|liggghts)_n(\d+)_(.+)_r(\d+)\.out$")
-
-
-def read_peer_log(path):
-    """A LAMMPS or LIGGGHTS run's last loop (the timed run after the warm-up), in seconds per step: the
-    total ('Loop time of') and its breakdown: the pair style, the neighbour lists, and the rest (fixes, among
-    them the integrator and the walls, communication, output, other). LAMMPS prints its breakdown as
-    'Pair | min | avg | max | ...' rows, LIGGGHTS (a LAMMPS of 2013) as 'Pair  time (%) = t (p)' lines.
-    Returns (steps, particles, {phase: seconds per step})."""
-    text = open(path).read()
-    loops = list(re.finditer(r"^Loop time of (\S+) on \d+ procs? for (\d+) steps with (\d+) atoms", text, re.M))
-    if not loops:
-        sys.exit(f"plot_peers.py: {path}: no 'Loop time of' line: the run failed (its output is that file)")
-    last = loops[-1]
-    total, steps, particles = float(last[1]), int(last[2]), int(last[3])
-    tail = text[last.end():]
-    sections = {}
-    for name, avg in re.findall(r"^(Pair|Neigh)\s*\|[^|]*\|\s*(\S+)\s*\|", tail, re.M):  # avg, the middle column
-        sections.setdefault(name, float(avg))
-    for name, t in re.findall(r"^(Pair|Neigh)\s+time \(%\) = (\S+)", tail, re.M):
-        sections.setdefault(name, float(t))
-    if set(sections) != {"Pair", "Neigh"}:
-        sys.exit(f"plot_peers.py: {path}: no Pair and Neigh times after the last 'Loop time of'")
-    pair, neigh = sections["Pair"], sections["Neigh"]
-    return steps, particles, {"total": total / steps, "pair": pair / steps, "neigh": neigh / steps,
-                              "rest": (total - pair - neigh) / steps}
-
-
 def cmd_bench(a):
-    rows = []
-    provenance = None
-    for f in sorted(glob.glob(os.path.join(a.work, "suite_n*_*_r*.json"))):
-        res = load(f)
-        provenance = provenance or res.provenance
-        stem = os.path.basename(f)[len("suite_n"):-len(".json")]
-        n, stage, rep = stem.split("_")[0], "_".join(stem.split("_")[1:-1]), stem.split("_")[-1][1:]
-        for s in res.meta["summary"]:
-            for phase in ["total"] + SUITE_PHASES:
-                rows.append({"code": "suite", "variant": s["variant"], "particles": int(n), "stage": stage,
-                             "repetition": int(rep), "steps": res.meta["steps"], "phase": phase,
-                             "seconds_per_step": s["seconds_per_step"][phase]["median"]})
-    for f in sorted(glob.glob(os.path.join(a.work, "*.out"))):
-        m = PEER_LOG.match(os.path.basename(f))
-        if not m:
-            continue
-        code, n, stage, rep = m[1], int(m[2]), m[3], int(m[4])
-        steps, particles, seconds = read_peer_log(f)
-        if particles != n:
-            sys.exit(f"plot_peers.py: {f}: {particles} atoms, not the {n} of its name")
-        rows += [{"code": code, "variant": code, "particles": n, "stage": stage, "repetition": rep, "steps": steps,
-                  "phase": phase, "seconds_per_step": t} for phase, t in seconds.items()]
-    write_bench(pd.DataFrame(rows), provenance, json.load(open(a.versions)), a.out, a.figure)
-
-
-def paired_ratios(df):
-    """Each code's time over LAMMPS's in the same repetition (the two run side by side), per code, stage
-    and N: the median and the range over the repetitions. Robust to a shared machine's slower hours, which
-    move both samples of a repetition alike, where the ratio of the medians may pair a quiet hour's
-    sample with a loaded one's."""
-    tot = df[df.phase == "total"]
-    lam = tot[tot.code == "lammps"].set_index(["stage", "particles", "repetition"])["us_per_particle_step"]
-    key = list(zip(tot.stage, tot.particles, tot.repetition))
-    r = tot.assign(paired=[t / lam.get(k, float("nan")) for t, k in zip(tot.us_per_particle_step, key)]).dropna(subset=["paired"])
-    g = r.groupby(["code", "variant", "stage", "particles"])["paired"]
-    return g.median().rename("paired_ratio").to_frame().join(g.min().rename("paired_min")).join(
-        g.max().rename("paired_max")).reset_index()
-
-
-def timed_steps(df, stage, n):
-    """The timed steps of one stage at one N, as a table cell: one number when every run had the same."""
-    k = sorted(df[(df.stage == stage) & (df.particles == n)].steps.unique())
-    return "/".join(str(int(v)) for v in k)
-
-
-def steps_note(df):
-    """What the tables' last rows, the timed steps, mean for reading one N beside another."""
-    if df.steps.nunique() == 1:
-        return "Every code runs the same timed steps at every N (each table's last row)."
-    return ("The timed steps differ from one N to another (each table's last row): on a stage that changes as it "
-            "runs (the loose grid falls and its grains collide, the compression stage is squeezed), each N covers a "
-            "different stretch of it, so one N's ratios are read beside another's with that in mind (docs/peers.md, "
-            "the loose grid).")
+    df, provenance = read_work(a.work)
+    write_bench(df, provenance, json.load(open(a.versions)), a.out, a.figure)
 
 
 def write_bench(df, provenance, versions, out, figure):
-    """Medians, ratios to LAMMPS, bench_peers.{csv,json,md} in out, and the figure, from every sample."""
-    if df.empty:
-        sys.exit("plot_peers.py: no samples")
-    df["us_per_particle_step"] = df["seconds_per_step"] / df["particles"] * 1e6
-    phases = df[df.phase != "total"]
-    g = df[df.phase == "total"].groupby(["code", "variant", "stage", "particles"])["us_per_particle_step"]
-    med = g.median().rename("median").to_frame().join(g.min().rename("min")).join(g.max().rename("max")) \
-        .join(g.count().rename("repetitions")).reset_index()
-    lam = med[med.code == "lammps"].set_index(["stage", "particles"])["median"]
-    med["ratio_to_lammps"] = [r["median"] / lam.get((r["stage"], r["particles"]), float("nan")) for _, r in med.iterrows()]
-    med = med.merge(paired_ratios(df), on=["code", "variant", "stage", "particles"], how="left")
-    os.makedirs(out, exist_ok=True)
-    csv = os.path.join(out, "bench_peers.csv")
-    write_text(csv, med.to_csv(index=False, float_format="%.6g"))
-    doc = {"provenance": provenance, "peers": versions, "timing": {
-        "suite": "demmat bench: sum of the four timed phases per step (health checks excluded), median over its own run",
-        "peers": "the code's own 'Loop time of' for the timed run after a warm-up run, divided by its steps"},
-        "summary": med.to_dict("records"), "samples": df.to_dict("records")}
-    write_text(os.path.join(out, "bench_peers.json"), json.dumps(doc, indent=1) + "\n")
-
-    # Figure: µs per particle-step against N, one panel per stage.
+    """Medians, ratios to the reference LAMMPS, bench_peers.{csv,json,md} in out, and the figure, from every sample."""
+    df, med, ref = summarise(df)
+    write_json(df, med, provenance, versions, out)
+    # Figure: µs per particle-step against N, one panel per stage; more threads dashed and hollow.
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.8), sharey=True)
     for ax, stage in zip(axes, STAGES):
         m = med[med.stage == stage]
-        for (code, variant), s in m.groupby(["code", "variant"]):
+        for (code, variant, threads), s in m.groupby(["code", "variant", "threads"]):
             s = s.sort_values("particles")
-            peer = code != "suite"
-            kw = style(variant)
-            if peer:
-                kw.update(linewidth=2.5, linestyle="--" if code == "liggghts" else "-", markersize=6)
+            kw = style(variant, threads)
+            if code != "suite":
+                kw.update(linewidth=2.5, markersize=6)
+                if code == "liggghts":
+                    kw.update(linestyle=":")
             ax.errorbar(s.particles, s["median"], yerr=[s["median"] - s["min"], s["max"] - s["median"]],
-                        label=variant if not peer else variant.upper(), linewidth=kw.pop("linewidth", 1.0), capsize=2, **kw)
+                        label=peer_label(variant, versions, threads), linewidth=kw.pop("linewidth", 1.0), capsize=2, **kw)
         n_axis(ax, med.particles)
         ax.set_yscale("log")
         ax.set_title(STAGE_TITLE[stage])
         ax.grid(True, which="both", alpha=0.3)
     axes[0].set_ylabel("µs per particle-step (median, min–max)")
     handles, labels = axes[0].get_legend_handles_labels()
-    order = sorted(range(len(labels)), key=lambda k: variant_key(labels[k].lower()))
-    legend_outside(axes[-1], [handles[k] for k in order], [labels[k] for k in order])
+    legend_outside(axes[-1], handles, labels)
     cpu = (provenance or {}).get("cpu", "")
-    peers = f"LAMMPS {versions.get('lammps', '')}" + (f", LIGGGHTS {versions['liggghts']}" if versions.get("liggghts") else "")
     law = versions.get("contact_law", "")
-    fig.suptitle(f"One core each: the suite's variants, {peers} ({cpu})" + (f"\ncontact law: {law}" if law else ""), fontsize=10)
-    save_figure(fig, figure, footer(provenance or {}, f"median of {int(med.repetitions.max())} interleaved repetitions, one core per code"),
-                dpi=110)
-
-    # Markdown: ratio to LAMMPS (same run), per stage and N.
-    lines = ["# The suite beside LAMMPS and LIGGGHTS: time per step relative to LAMMPS",
-             "",
-             f"Median of {int(med.repetitions.max())} interleaved repetitions, one core per code. "
-             f"LAMMPS {versions.get('lammps', '?')} (Debian {versions.get('lammps_package', '?')}), "
-             + (f"LIGGGHTS {versions['liggghts']} (Debian {versions.get('liggghts_package', '?')}); " if versions.get("liggghts") else "no LIGGGHTS; ")
-             + f"suite commit {(provenance or {}).get('commit', '?')}, {(provenance or {}).get('compiler', '?')}, "
-             f"CPU {cpu}. Ratio < 1: faster than LAMMPS. Per stage, the ratio of the medians, then the paired ratios. "
-             f"Produced by scripts/run_peers.sh; every sample in bench_peers.json.", "",
-             steps_note(df), "",
-             f"Contact law: {versions.get('contact_law', 'the paper' + chr(39) + 's (physics.md section 2)')}.", ""]
-    ns = sorted(med.particles.unique())
-    for stage in STAGES:
-        m = med[med.stage == stage]
-        lines += [f"## {STAGE_TITLE[stage]}", "",
-                  "| code | " + " | ".join(f"N = {n}" for n in ns) + " |",
-                  "|---|" + "---:|" * len(ns)]
-        order = sorted(m.variant.unique(), key=lambda v: (v in ("lammps", "liggghts"), v))
-        for v in order:
-            cells = []
-            for n in ns:
-                r = m[(m.variant == v) & (m.particles == n)]
-                cells.append("" if r.empty else f"{r.ratio_to_lammps.iloc[0]:.2f}")
-            lines.append(f"| {v} | " + " | ".join(cells) + " |")
-        lam_row = [m[(m.variant == 'lammps') & (m.particles == n)]["median"] for n in ns]
-        lines.append("| *LAMMPS µs per particle-step* | " + " | ".join("" if r.empty else f"{r.iloc[0]:.3f}" for r in lam_row) + " |")
-        lines.append("| *timed steps* | " + " | ".join(timed_steps(df, stage, n) for n in ns) + " |")
-        lines += ["", "Paired: each repetition's own ratio (the code and LAMMPS run side by side), median (min–max).", "",
-                  "| code | " + " | ".join(f"N = {n}" for n in ns) + " |",
-                  "|---|" + "---:|" * len(ns)]
-        for v in order:
-            if v == "lammps":
-                continue
-            cells = []
-            for n in ns:
-                r = m[(m.variant == v) & (m.particles == n)]
-                cells.append("" if r.empty else f"{r.paired_ratio.iloc[0]:.2f} ({r.paired_min.iloc[0]:.2f}–{r.paired_max.iloc[0]:.2f})")
-            lines.append(f"| {v} | " + " | ".join(cells) + " |")
-        lines.append("")
-    lines += phase_table(phases, "bed")
-    write_text(os.path.join(out, "bench_peers.md"), "\n".join(lines))
-    print(f"results: {csv}, {os.path.join(out, 'bench_peers.json')}, {os.path.join(out, 'bench_peers.md')}, {figure}")
-
-
-def phase_table(phases, stage):
-    """Markdown: µs per particle-step by each code's own phases on one stage (median over the repetitions),
-    the suite's predict and correct as one row (fast does its corrector in the next step's Gear pass)."""
-    p = phases[phases.stage == stage].copy()
-    if p.empty:
-        return []
-    p["phase"] = p.phase.replace({"correct": "predict"})
-    per_rep = p.groupby(["code", "variant", "particles", "phase", "repetition"])["us_per_particle_step"].sum()
-    med = per_rep.groupby(["code", "variant", "particles", "phase"]).median()
-    ns = sorted(p.particles.unique())
-    lines = [f"## Where the time goes: {STAGE_TITLE[stage]}", "",
-             "µs per particle-step in each code's own phases (median over the repetitions). The phases do not "
-             "map one to one: the walls' law is in the suite's forces and in the peers' fixes (the rest); "
-             "docs/peers.md says what each phase holds.", "",
-             "| code | phase | " + " | ".join(f"N = {n}" for n in ns) + " |",
-             "|---|---|" + "---:|" * len(ns)]
-    variants = sorted(p.variant.unique(), key=lambda v: (v in ("lammps", "liggghts"), v))
-    for v in variants:
-        code = p[p.variant == v].code.iloc[0]
-        for phase in (["predict", "search", "forces"] if code == "suite" else PEER_PHASES):
-            cells = [med.get((code, v, n, phase), float("nan")) for n in ns]
-            lines.append(f"| {v} | {PHASE_TITLE[phase]} | " + " | ".join("" if math.isnan(c) else f"{c:.4f}" for c in cells) + " |")
-    return lines + [""]
+    fig.suptitle(f"The suite's variants beside {peer_label(ref, versions)} ({cpu})" + (f"\ncontact law: {law}" if law else ""), fontsize=10)
+    save_figure(fig, figure, footer(provenance or {}, f"median of {int(med.repetitions.max())} interleaved repetitions"), dpi=110)
+    write_text(os.path.join(out, "bench_peers.md"), markdown(df, med, ref, provenance, versions))
+    print(f"results: {os.path.join(out, 'bench_peers.md')} (.csv, .json), {figure}")
 
 
 # ---- observables -----------------------------------------------------------------------------------------
@@ -404,9 +234,8 @@ def write_physics(df, versions, particles, amplitude, out, figure):
 
 def cmd_replot_bench(a):
     """The tables and the figure again from bench_peers.json (every sample is in it), beside it."""
-    res = load(a.json)
-    df = res.table.drop(columns=["threads", "sample"]).rename(columns={"N": "particles", "seconds": "seconds_per_step"})
-    write_bench(df.drop(columns=["us_per_particle_step"]), res.provenance, res.meta["peers"], os.path.dirname(a.json), a.figure)
+    df, provenance, versions = replot_frame(a.json)
+    write_bench(df, provenance, versions, os.path.dirname(a.json), a.figure)
 
 
 def cmd_replot_physics(a):

@@ -91,7 +91,9 @@ def load(path):
         return _run(path, raw)
     if "peers" in raw and "summary" in raw:
         df = pd.DataFrame(raw["samples"]).rename(columns={"particles": "N", "seconds_per_step": "seconds"})
-        df["threads"], df["sample"] = 1, range(len(df))  # one core per code
+        if "threads" not in df:  # files of before the thread comparison: one core per code
+            df["threads"] = 1
+        df["sample"] = range(len(df))
         if "phase" not in df:  # files of before the phases: the step's time only
             df["phase"] = "total"
         return Result("peers", path, normalise_provenance(raw.get("provenance")), df,
@@ -263,7 +265,7 @@ STYLE = {
     "arrays": ("#1f77b4", "o"), "eigen_soa": ("#ff7f0e", "D"), "linked_list": ("#2ca02c", "^"),
     "linked_list_pool": ("#17becf", "v"), "linked_list_rebuild": ("#bcbd22", "<"), "oop": ("#d62728", "s"),
     "fast": ("#9467bd", "*"), "fast_unordered": ("#e377c2", "P"), "f90": ("#8c564b", "X"), "pascal": ("#000080", "h"),
-    "lammps": ("#000000", "p"), "liggghts": ("#7f7f7f", "H"),
+    "lammps_native": ("#000000", "d"), "lammps": ("#000000", "p"), "liggghts": ("#7f7f7f", "H"),
 }
 VARIANT_ORDER = list(STYLE)
 

@@ -1,4 +1,4 @@
-// What each model feature costs per step (issue 10; docs/design.md, "Model features").
+// What each model feature costs per step (docs/design.md, "Model features").
 //
 // One monodisperse dense bed, settled once with every feature on (cached in --states-dir), then six
 // scenes made from it, each needing one feature more than the one before:

@@ -1,4 +1,4 @@
-// The suite's Google Benchmark program: every family of measurement behind the figures of issue 7.
+// The suite's Google Benchmark program: every family of measurement behind the figures (docs/benchmarks.md).
 //
 //   phases/...    registry × N × state (loose grid, settled bed, compression stage) [× threads]:
 //                 per-phase seconds per step, µs per particle-step, contacts and candidates per particle,

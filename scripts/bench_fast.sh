@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The fast variant's benchmark (docs/variants.md, "fast"): for each N, the dense bed settled once
+# The fast variant's benchmark (docs/variants/fast.md): for each N, the dense bed settled once
 # (0.4 s simulated with fast on every core, kept in states/), then `demmat bench` of arrays, fast and
 # fast_unordered on the settled bed (walls at rest) at each thread count, interleaved repetitions,
 # medians; then the loose lattice of 10^6 particles benchmarked the same way, and run a few steps to show

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# What each model feature costs per step (issue 10; docs/design.md, "Model features"): builds
+# What each model feature costs per step (docs/design.md, "Model features"): builds
 # demmat_bench_features, settles a monodisperse dense bed once (kept in states/), times the six levels
 # (normal force only, + damping, + friction/rotation, + walls, + moving walls, + polydisperse), each with
 # the specialised model and with the full model, for arrays, eigen_soa and fast (one core), in interleaved repetitions,

@@ -1,17 +1,27 @@
 #!/usr/bin/env bash
 # The suite side by side with LAMMPS and LIGGGHTS on the same scenes (docs/peers.md): installs the peers
-# (Debian's lammps and liggghts), builds, settles the dense beds, exports every stage as a LAMMPS data
-# file so that every code starts from the identical particles, then
+# (Debian's lammps and liggghts) and LAMMPS built on this machine (scripts/build_lammps.sh: -O3
+# -march=native, GRANULAR and OPENMP), builds, settles the dense beds, exports every stage as a LAMMPS
+# data file so that every code starts from the identical particles, then
 #  1. the peer benchmark: every code on one core (OMP_NUM_THREADS=1, no MPI) for the loose grid, the
 #     settled bed and the compression stage, N in the list, repetitions interleaved (the codes' order
 #     rotated every repetition), timings from each code's own loop time and its phases; results/peers/bench_*.
+#     LAMMPS built here is the reference, Debian's binary a second row; with --threads, the suite's
+#     threaded variants and LAMMPS built here with its OPENMP package (-sf omp -pk omp T) on T threads too.
 #  2. the physics cross-check: an ensemble of perturbed starts per code from the same particles, the
 #     kinetic energy and bed height while settling, the wall force while compressing; results/peers/physics_*.
 # Usage: scripts/run_peers.sh [--full] [--n "1000 2000"] [--steps K] [--repetitions R] [--variants LIST]
-#                             [--members M] [--physics-n N] [--bench-only] [--physics-only] [--prepare-only]
-#                             [--contact "KEY=VALUE ..."] [--diagnose] [--out DIR] [--build-dir DIR]
-#   default          N = 1000, 2000, 4000; 200 steps; 3 repetitions; every variant; 4 ensemble members
-#   --full           N = 1000 … 64000 (doubling), 500 steps, 5 repetitions, 8 ensemble members (the lead's run)
+#                             [--threads "1 2"] [--members M] [--physics-n N] [--bench-only] [--physics-only]
+#                             [--prepare-only] [--contact "KEY=VALUE ..."] [--diagnose] [--no-liggghts]
+#                             [--note TEXT] [--out DIR] [--build-dir DIR]
+#   default          N = 1000, 2000, 4000; 200 steps; 3 repetitions; every variant; one thread;
+#                    4 ensemble members
+#   --full           N = 1000 … 64000 (doubling), 500 steps, 5 repetitions, threads 1 and 2, 8 ensemble
+#                    members (the lead's run)
+#   --threads LIST   the thread counts of the benchmark: 1 times every code on one core; T > 1 the suite's
+#                    threaded variants on T threads beside LAMMPS built here with -sf omp -pk omp T
+#   --no-liggghts    LIGGGHTS left out (a run about the suite and LAMMPS alone)
+#   --note TEXT      a sentence for the results' header (what the tables cannot say: a shared machine)
 #   --steps K        the timed steps of each run, at least: a small N runs more, so that every timed run
 #                    holds at least 10^6 particle-steps (1000 steps at N = 1000), long enough that a burst
 #                    of another tenant's work on the shared machine is a small part of it
@@ -35,13 +45,17 @@
 source "$(dirname "$0")/lib.sh"
 ns="1000 2000 4000"; steps=200; reps=3; variants=all; members=4; phys_n=2000; warmup=20
 do_bench=1; do_phys=1; prepare_only=0; diagnose=0; out=results/peers; figures=results/figures; contact=""
+threads=1; note=""; no_liggghts=0
 while [[ $# -gt 0 ]]; do
   case "$1" in
-    --full) ns="1000 2000 4000 8000 16000 32000 64000"; steps=500; reps=5; members=8; shift ;;
+    --full) ns="1000 2000 4000 8000 16000 32000 64000"; steps=500; reps=5; threads="1 2"; members=8; shift ;;
     --n) need_value "$@"; ns=$2; shift 2 ;;
     --steps) need_value "$@"; steps=$2; shift 2 ;;
     --repetitions) need_value "$@"; reps=$2; shift 2 ;;
     --variants) need_value "$@"; variants=$2; shift 2 ;;
+    --threads) need_value "$@"; threads=$2; shift 2 ;;
+    --note) need_value "$@"; note=$2; shift 2 ;;
+    --no-liggghts) no_liggghts=1; shift ;;
     --members) need_value "$@"; members=$2; shift 2 ;;
     --physics-n) need_value "$@"; phys_n=$2; shift 2 ;;
     --bench-only) do_phys=0; shift ;;
@@ -54,10 +68,14 @@ while [[ $# -gt 0 ]]; do
   esac
 done
 for n in $ns; do positive_int --n "$n"; done
+for t in $threads; do positive_int --threads "$t"; done
 positive_int --steps "$steps"; positive_int --repetitions "$reps"; positive_int --members "$members"
 positive_int --physics-n "$phys_n"
 
 install_deps --optional
+# LAMMPS built here: only the benchmark times it (the physics cross-check runs Debian's binary).
+lmp_native=""
+if [[ $do_bench == 1 && $prepare_only == 0 ]]; then lmp_native=$(scripts/build_lammps.sh --build-dir "$BUILD_DIR"); fi
 cmake_build -q "$BUILD_DIR" demmat
 demmat=$(demmat_in "$BUILD_DIR")
 if [[ $diagnose == 1 && $do_phys == 1 ]]; then
@@ -66,6 +84,7 @@ if [[ $diagnose == 1 && $do_phys == 1 ]]; then
 fi
 lmp=$(command -v lmp || true)
 liggghts=$(command -v liggghts || true)
+[[ $no_liggghts == 1 ]] && liggghts=""
 # A contact law: its stages live in a folder of their own beside the paper's (law_<keys>), its scene
 # options are checked now (a scene of one grain), before any settling.
 contact_args=(); law_dir=""
@@ -87,12 +106,18 @@ mkdir -p "$work" "$out"
   echo "{"
   echo "  \"lammps\": \"$($lmp -h | sed -n 's/^Large-scale Atomic.Molecular Massively Parallel Simulator - //p' | head -1)\","
   echo "  \"lammps_package\": \"$(dpkg-query -W -f='${Version}' lammps 2>/dev/null)\","
+  if [[ -n $lmp_native ]]; then
+    echo "  \"lammps_native\": \"$($lmp_native -h | sed -n 's/^Large-scale Atomic.Molecular Massively Parallel Simulator - //p' | head -1)\","
+    echo "  \"lammps_native_flags\": \"-O3 -march=native\","
+    echo "  \"lammps_native_build\": \"$(scripts/build_lammps.sh --build-dir "$BUILD_DIR" --print-stamp)\","
+  fi
+  [[ -n $note ]] && echo "  \"note\": $($PYTHON -c 'import json, sys; print(json.dumps(sys.argv[1]))' "$note"),"
   if [[ -n "$liggghts" ]]; then
     echo "  \"liggghts\": \"$($liggghts -h 2>&1 | sed -n 's/^LIGGGHTS (Version \([^,]*\),.*/\1/p' | head -1)\","
     echo "  \"liggghts_package\": \"$(dpkg-query -W -f='${Version}' liggghts 2>/dev/null)\","
   fi
   echo "  \"contact_law\": \"${contact:-paper (physics.md section 2)}\","
-  echo "  \"mpi\": \"none (serial runs, OMP_NUM_THREADS=1)\""
+  echo "  \"mpi\": \"none (one process per run; OMP_NUM_THREADS=1, more threads only where --threads asks)\""
   echo "}"
 } > "$work/versions.json"
 
@@ -141,23 +166,31 @@ fi
 if [[ $do_bench == 1 ]]; then
   # Each run's raw output stays in $work: the suite's `demmat bench --json`, the peers' logs, whose last
   # loop time and breakdown plot_peers.py reads.
-  rm -f "$work"/suite_n*_*.json "$work"/lammps_n*_*.out "$work"/liggghts_n*_*.out
+  rm -f "$work"/suite_*.json "$work"/lammps_*.out "$work"/liggghts_*.out
   for n in $ns; do prepare "$n"; done
-  codes=(suite lammps); [[ -n "$liggghts" ]] && codes+=(liggghts)
+  # The runs of one repetition: code@threads. The suite times every thread count in one bench run
+  # (interleaved inside it); LAMMPS built here runs once per thread count; the others on one core.
+  suite_threads=$(tr ' ' ',' <<<"$threads")
+  codes=(suite@1 lammps_native@1 lammps@1); [[ -n "$liggghts" ]] && codes+=(liggghts@1)
+  for t in $threads; do [[ $t == 1 ]] || codes+=("lammps_native@$t"); done
   for ((r = 0; r < reps; r++)); do
     for n in $ns; do
       d=$(stage_dir "$n")
       k=$(( (1000000 + n - 1) / n )); (( k < steps )) && k=$steps  # the timed steps at this N
       for stage in loose bed compression; do
         for ((q = 0; q < ${#codes[@]}; q++)); do
-          code=${codes[$(((q + r) % ${#codes[@]}))]}   # rotated each repetition: drift hits all alike
+          run=${codes[$(((q + r) % ${#codes[@]}))]}   # rotated each repetition: drift hits all alike
+          code=${run%@*}; t=${run#*@}
           case $code in
             suite)
-              $demmat bench "$d/$stage.toml" --variants "$variants" --steps "$k" --warmup "$warmup" --repetitions 1 \
-                --json "$work/suite_n${n}_${stage}_r${r}.json" >/dev/null 2>&1 ;;
-            lammps)
-              (cd "$d" && $lmp -var frag "$stage.lammps" -var warmup "$warmup" -var steps "$k" \
-                 -in "$OLDPWD/peers/lammps/in.bench" -log none -nocite > "$work/lammps_n${n}_${stage}_r${r}.out" 2>&1) ;;
+              $demmat bench "$d/$stage.toml" --variants "$variants" --threads "$suite_threads" --steps "$k" --warmup "$warmup" \
+                --repetitions 1 --json "$work/suite_n${n}_${stage}_r${r}.json" >/dev/null 2>&1 ;;
+            lammps|lammps_native)
+              exe=$lmp; omp=()
+              [[ $code == lammps_native ]] && exe=$lmp_native
+              (( t > 1 )) && omp=(-sf omp -pk omp "$t")
+              (cd "$d" && $exe "${omp[@]}" -var frag "$stage.lammps" -var warmup "$warmup" -var steps "$k" \
+                 -in "$OLDPWD/peers/lammps/in.bench" -log none -nocite > "$work/${code}_t${t}_n${n}_${stage}_r${r}.out" 2>&1) ;;
             liggghts)
               (cd "$d" && $liggghts -var frag "$stage.liggghts" -var warmup "$warmup" -var steps "$k" \
                  -in "$OLDPWD/peers/liggghts/in.bench" -log none -nocite > "$work/liggghts_n${n}_${stage}_r${r}.out" 2>&1) ;;

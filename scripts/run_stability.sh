@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The stability study (issue 9; docs/stability.md): builds demmat_stability, finds the largest stable Δt
+# The stability study (docs/stability.md): builds demmat_stability, finds the largest stable Δt
 # for every integrator × precision of the arrays variant on a head-on pair, a sphere hitting a wall and a
 # dense bed of 125 grains, across restitution and stiffness, and writes results/stability/ (JSON with
 # provenance, Markdown table) and results/figures/stability_map.png. About two minutes on two cores;

@@ -9,6 +9,7 @@ Run by ctest (analysis.results) with /usr/bin/python3.
 """
 import json
 import os
+import re
 import shutil
 import subprocess
 import sys
@@ -232,8 +233,10 @@ class PeersBench(unittest.TestCase):
     of each code's phases."""
 
     def setUp(self):
+        import peers_bench
         import plot_peers
         self.peers = plot_peers
+        self.read_peer_log = peers_bench.read_peer_log
         self.work = tempfile.mkdtemp()
         self.addCleanup(shutil.rmtree, self.work)
 
@@ -245,7 +248,7 @@ class PeersBench(unittest.TestCase):
 
     def test_the_timed_loop_is_the_last_and_the_rest_is_what_pair_and_neigh_leave(self):
         for text, pair, neigh in ((LAMMPS_LOG, 2.2243, 0.046851), (LIGGGHTS_LOG, 2.17117, 0.0911109)):
-            steps, particles, sec = self.peers.read_peer_log(self.log("x.out", text))
+            steps, particles, sec = self.read_peer_log(self.log("x.out", text))
             total = 3.16708 if text is LAMMPS_LOG else 2.75224
             self.assertEqual((steps, particles), (200, 64000))
             self.assertAlmostEqual(sec["total"], total / 200, places=15)
@@ -255,7 +258,7 @@ class PeersBench(unittest.TestCase):
 
     def test_a_failed_run_is_named(self):
         with self.assertRaises(SystemExit) as e:
-            self.peers.read_peer_log(self.log("lammps_n1000_bed_r0.out", "ERROR: Cannot open file bed.data\n"))
+            self.read_peer_log(self.log("lammps_n1000_bed_r0.out", "ERROR: Cannot open file bed.data\n"))
         self.assertIn("lammps_n1000_bed_r0.out", str(e.exception))
 
     def test_phase_table_sums_predict_and_correct_per_repetition_then_takes_the_median(self):
@@ -273,12 +276,12 @@ class PeersBench(unittest.TestCase):
         self.peers.write_bench(pd.DataFrame(rows), {}, versions, self.work, os.path.join(self.work, "f.png"))
         text = open(os.path.join(self.work, "bench_peers.md")).read()
         cells = {line.split("|")[1].strip() + "/" + line.split("|")[2].strip().split(" ")[0]: line.split("|")[3].strip()
-                 for line in text.split("## Where the time goes")[1].splitlines() if line.startswith("| fast") or line.startswith("| lammps")}
+                 for line in text.split("## Where the time goes")[1].splitlines() if line.startswith("| fast") or line.startswith("| LAMMPS")}
         # per repetition 0.011, 0.023, 0.032 µs per particle-step: the median is 0.023 (not 0.02 + 0.002)
         self.assertEqual(cells["fast/predict"], "0.0230")
         self.assertEqual(cells["fast/forces"], "0.0500")
-        self.assertEqual(cells["lammps/Pair"], "0.0800")
-        self.assertEqual(cells["lammps/rest"], "0.0200")
+        self.assertEqual(cells["LAMMPS Debian (-g -O2, baseline x86-64)/Pair"], "0.0800")
+        self.assertEqual(cells["LAMMPS Debian (-g -O2, baseline x86-64)/rest"], "0.0200")
         ratio = [line for line in text.splitlines() if line.startswith("| fast |")][0].split("|")[2].strip()
         self.assertEqual(ratio, f"{(2e-5 + 3e-6 + 5e-5) / 1.01e-4:.2f}")  # totals only in the ratio table
 
@@ -311,7 +314,7 @@ class PeersBench(unittest.TestCase):
                                  "repetition": 0, "steps": k, "phase": "total", "seconds_per_step": 1e-4})
             self.peers.write_bench(pd.DataFrame(rows), {}, {"lammps": "test"}, self.work, os.path.join(self.work, "f.png"))
             with open(os.path.join(self.work, "bench_peers.md")) as f:
-                return f.read().split("## ")[1]  # the loose grid's table
+                return f.read().split("### loose grid")[1].split("###")[0]  # the loose grid's table
 
         text = table({1000: 1000, 4000: 250})
         row = [line for line in text.splitlines() if line.startswith("| *timed steps*")]
@@ -324,6 +327,77 @@ class PeersBench(unittest.TestCase):
             whole = f.read()
         self.assertIn("the same timed steps at every N", whole)
         self.assertNotIn("differ from one N to another", whole)
+
+    def sample(self, code, variant, threads, stage, rep, seconds, n=1000, ran_on=None):
+        return {"code": code, "variant": variant, "threads": threads, "ran_on": ran_on or threads, "particles": n,
+                "stage": stage, "repetition": rep, "steps": 1000, "phase": "total", "seconds_per_step": seconds}
+
+    def bench_md(self, rows, versions):
+        import pandas as pd
+        self.peers.write_bench(pd.DataFrame(rows), {"cpu": "test CPU"}, versions, self.work, os.path.join(self.work, "f.png"))
+        with open(os.path.join(self.work, "bench_peers.md")) as f:
+            return f.read()
+
+    NATIVE = {"lammps": "29 Sep 2021", "lammps_package": "1-2+b2", "lammps_native": "29 Sep 2021",
+              "lammps_native_flags": "-O3 -march=native",
+              "lammps_native_build": "source lammps 1-2; flags -O3 -march=native; packages GRANULAR OPENMP"}
+
+    def test_both_lammps_builds_are_rows_named_with_their_flags_and_the_native_one_is_the_reference(self):
+        rows = []
+        for rep in range(3):
+            rows += [self.sample("suite", "fast", 1, "bed", rep, 4e-5), self.sample("lammps_native", "lammps_native", 1, "bed", rep, 1e-4),
+                     self.sample("lammps", "lammps", 1, "bed", rep, 1.5e-4)]
+        text = self.bench_md(rows, self.NATIVE)
+        self.assertIn("relative to LAMMPS -O3 -march=native", text.splitlines()[0])
+        self.assertIn("packages GRANULAR OPENMP", text)          # the build's stamp, in the header
+        self.assertIn("Debian's binary of LAMMPS 29 Sep 2021 (package 1-2+b2; -g -O2, baseline x86-64", text)
+        table = text.split("### settled bed")[1].split("Paired")[0]
+        self.assertIn("| fast | 0.40 |", table)
+        self.assertIn("| LAMMPS -O3 -march=native | 1.00 |", table)
+        self.assertIn("| LAMMPS Debian (-g -O2, baseline x86-64) | 1.50 |", table)
+        self.assertIn("| *LAMMPS -O3 -march=native: µs per particle-step* | 0.100 |", table)
+        with open(os.path.join(self.work, "bench_peers.json")) as f:
+            self.assertEqual(json.load(f)["reference"], "lammps_native")
+
+    def test_two_threads_are_taken_against_lammps_openmp_on_two_and_a_run_on_fewer_is_marked(self):
+        rows = []
+        for rep in range(3):
+            rows += [self.sample("suite", "fast", 1, "bed", rep, 4e-5), self.sample("lammps_native", "lammps_native", 1, "bed", rep, 1e-4),
+                     self.sample("suite", "fast", 2, "bed", rep, 3e-5, ran_on=1),
+                     self.sample("lammps_native", "lammps_native", 2, "bed", rep, 6e-5)]
+        text = self.bench_md(rows, self.NATIVE)
+        two = text.split("## 2 threads")[1]
+        self.assertIn("| fast, 2 threads | 0.50 † |", two)   # against LAMMPS on two threads (6e-5), not on one
+        self.assertIn("| LAMMPS -O3 -march=native, OPENMP 2 threads | 1.00 |", two)
+        self.assertIn("-sf omp -pk omp 2", two)
+        speed_up = two.split("### From one thread to 2")[1]
+        self.assertIn("| fast, 2 threads | settled bed | 1.33 |", speed_up)
+        self.assertIn("| LAMMPS -O3 -march=native, OPENMP 2 threads | settled bed | 1.67 |", speed_up)
+
+    def test_targets_are_each_repetitions_ratio_against_its_limit(self):
+        rows = []
+        # fast 0.4 of LAMMPS (met), 1.2 of fast_unordered (missed by 9 %), the loose grid 2.0 of the bed
+        # (missed by 33 %), on two threads 0.9 of LAMMPS OPENMP (met).
+        for rep in range(3):
+            for stage, scale in (("bed", 1.0), ("loose", 2.0)):
+                rows += [self.sample("suite", "fast", 1, stage, rep, 4e-5 * scale),
+                         self.sample("suite", "fast_unordered", 1, stage, rep, 4e-5 * scale / 1.2),
+                         self.sample("lammps_native", "lammps_native", 1, stage, rep, 1e-4),
+                         self.sample("suite", "fast", 2, stage, rep, 2.7e-5), self.sample("lammps_native", "lammps_native", 2, stage, rep, 3e-5)]
+        targets = self.bench_md(rows, self.NATIVE).split("## fast's targets")[1].split("## ")[0]
+        self.assertIn("| fast ≤ 0.5× LAMMPS -O3 -march=native, one core | settled bed | 0.40 met |", targets)
+        self.assertIn("| fast ≤ 1.10× fast_unordered, one core | settled bed | 1.20 missed by 9 % |", targets)
+        self.assertIn("| fast's loose grid ≤ 1.5× its settled bed, one core | per particle-step | 2.00 missed by 33 % |", targets)
+        self.assertIn("| fast on 2 threads faster than LAMMPS -O3 -march=native, OPENMP 2 threads | settled bed | 0.90 met |", targets)
+        self.assertNotIn("compression", targets)   # no row for a stage that was not run
+
+    def test_work_folder_logs_name_the_build_and_the_threads(self):
+        import peers_bench
+        for name in ("lammps_native_t2_n64000_bed_r1.out", "lammps_t1_n64000_bed_r0.out", "lammps_n64000_compression_r2.out"):
+            self.log(name, LAMMPS_LOG)
+        df, _ = peers_bench.read_work(self.work)
+        got = sorted(set(zip(df.code, df.threads, df.stage, df.repetition)))
+        self.assertEqual(got, [("lammps", 1, "bed", 0), ("lammps", 1, "compression", 2), ("lammps_native", 2, "bed", 1)])
 
 
 class PeerContacts(unittest.TestCase):
@@ -429,9 +503,11 @@ class Report(unittest.TestCase):
             self.assertEqual(done.returncode, 0, done.stderr)
             self.assertEqual(done.stdout.strip(), out)
             text = open(out).read()
-            self.assertIn("## Machine and provenance", text)
-            self.assertIn("main/bench_compression_2000.json", text)
-            self.assertIn("sweep_short/bench.json", text)
+            self.assertIn("## Result sets", text)
+            self.assertIn("| [main](main) | Figure 7", text)
+            self.assertIn("| [sweep_short](sweep_short) |", text)
+            with open(os.path.join(root, "main", "set.json")) as f:
+                self.assertEqual(json.load(f)["question"], "Figure 7: each style phase by phase")
             self.assertIn("| arrays | 15.0 (1.00×) | 656.7 (1.00×)", text)  # Figure 7 from the bench sample: µs per step, medians of 2
             for script in ("scripts/run_figures.sh", "scripts/run_peers.sh", "scripts/run_accuracy.sh",
                            "scripts/run_stability.sh", "scripts/run_features.sh", "scripts/run_memory_cost.sh",
@@ -442,6 +518,27 @@ class Report(unittest.TestCase):
         finally:
             shutil.rmtree(root)
 
+
+    def test_fast_beside_both_lammps_builds_is_a_section_naming_their_flags(self):
+        import pandas as pd
+        import plot_peers
+        root = tempfile.mkdtemp()
+        self.addCleanup(shutil.rmtree, root)
+        rows = [{"code": code, "variant": code if code != "suite" else "fast", "threads": 1, "particles": 1000, "stage": "bed",
+                 "repetition": 0, "steps": 1000, "phase": "total", "seconds_per_step": t}
+                for code, t in (("suite", 4e-5), ("lammps_native", 1e-4), ("lammps", 1.2e-4))]
+        out = os.path.join(root, "peers_fast_xeon")
+        plot_peers.write_bench(pd.DataFrame(rows), {"cpu": "test CPU"}, PeersBench.NATIVE, out,
+                               os.path.join(out, "peers_us_per_particle_step.png"))
+        report = os.path.join(root, "REPORT.md")
+        done = subprocess.run([sys.executable, os.path.join(ANALYSIS, "make_report.py"), "--results", root, "--out", report],
+                              capture_output=True, text=True, timeout=120)
+        self.assertEqual(done.returncode, 0, done.stderr)
+        with open(report) as f:
+            text = f.read().split("## fast beside LAMMPS built for the CPU and Debian's binary (peers_fast_xeon)")[1]
+        self.assertIn("| LAMMPS -O3 -march=native | 1.00 |", text)
+        self.assertIn("| LAMMPS Debian (-g -O2, baseline x86-64) | 1.20 |", text)
+        self.assertIn("peers_fast_xeon/peers_us_per_particle_step.png", text)
 
     def test_validation_summary_counts_each_verdict(self):
         """Chung & Ooi's summary: passes over judged values, and the paper's law's expected differences apart."""
@@ -463,6 +560,151 @@ class Report(unittest.TestCase):
             self.assertNotIn("Produce it with `scripts/run_validation.sh`", text)
         finally:
             shutil.rmtree(root)
+
+
+    def test_the_answers_come_first_in_order_then_the_result_sets(self):
+        """On the repository's own results: every answer within the first 60 lines, in order, then provenance."""
+        import report_answers
+        with tempfile.TemporaryDirectory() as d:
+            root = os.path.join(d, "results")
+            shutil.copytree(os.path.join(HERE, os.pardir, "results"), root)
+            out = os.path.join(root, "REPORT.md")
+            done = subprocess.run([sys.executable, os.path.join(ANALYSIS, "make_report.py"), "--results", root, "--out", out],
+                                  capture_output=True, text=True, timeout=300)
+            self.assertEqual(done.returncode, 0, done.stderr)
+            with open(out, encoding="utf-8") as f:
+                lines = f.read().splitlines()
+        screen = "\n".join(lines[:60])
+        where = [screen.find(f"**{a}**") for a in report_answers.ANSWERS]
+        self.assertNotIn(-1, where, [a for a, w in zip(report_answers.ANSWERS, where) if w < 0])
+        self.assertEqual(where, sorted(where))
+        self.assertNotIn("not present", screen)  # every answer's result set is committed
+        self.assertLess(max(where), screen.find("## Result sets") if "## Result sets" in screen else len(screen))
+        self.assertIn("## Result sets", "\n".join(lines))
+        self.assertFalse([l for l in lines[:60] if l.startswith("## ") and l != "## Result sets"])
+        tests = [l for l in lines[:60] if re.match(r"- test \d: ", l)]
+        self.assertEqual(len(tests), 8)  # validation: one line per test
+
+    def test_a_set_measured_before_a_change_of_code_is_marked(self):
+        """The set's commit against the last commit that changed its code (a comment alone is no change)."""
+        import result_sets
+        with tempfile.TemporaryDirectory() as repo:
+            def git(*args):
+                return subprocess.run(["git", "-C", repo, "-c", "user.name=t", "-c", "user.email=t@t", *args],
+                                      capture_output=True, text=True, check=True).stdout.strip()
+
+            def commit(text, message):
+                os.makedirs(os.path.join(repo, "common"), exist_ok=True)
+                with open(os.path.join(repo, "common", "law.cpp"), "w") as f:
+                    f.write(text)
+                git("add", "-A")
+                git("commit", "-qm", message)
+                return git("rev-parse", "HEAD")
+
+            git("init", "-q")
+            measured = commit("int f() { return 1; }\n", "code")
+            prov = {"commits": {measured}, "cpus": {"cpu A"}, "dirty": False}
+            commit("// why f returns 1\nint f() { return 1; }\n", "a comment")
+            self.assertEqual(result_sets.status("", "main", prov, "cpu A", repo), "current")
+            self.assertEqual(result_sets.status("", "main", prov, "cpu B", repo), "another CPU")
+            changed = commit("// why f returns 1\nint f() { return 2; }\n", "code changed")
+            self.assertEqual(result_sets.status("", "main", prov, "cpu A", repo),
+                             f"older than the code it measured (changed at {changed[:10]})")
+            self.assertEqual(result_sets.status("", "main", {**prov, "commits": {changed}}, "cpu A", repo), "current")
+
+
+class Experiments(unittest.TestCase):
+    """results/experiments/README.md is the table of the records beside it, and a record is checked."""
+    FOLDER = os.path.join(HERE, os.pardir, "results", "experiments")
+
+    def test_the_committed_table_is_generated_from_the_records(self):
+        import experiments_table
+        records = experiments_table.load(self.FOLDER)
+        self.assertGreater(len(records), 30)
+        with open(os.path.join(self.FOLDER, "README.md"), encoding="utf-8") as f:
+            self.assertEqual(f.read(), experiments_table.render(records))
+        self.assertEqual(subprocess.run([sys.executable, os.path.join(ANALYSIS, "experiments_table.py"), "--check",
+                                         "--folder", self.FOLDER]).returncode, 0)
+
+    def test_a_changed_record_changes_the_table_and_a_bad_one_is_refused(self):
+        import experiments_table
+        with tempfile.TemporaryDirectory() as d:
+            for name in os.listdir(self.FOLDER):
+                shutil.copy(os.path.join(self.FOLDER, name), d)
+            path = os.path.join(d, "law-on-16-lanes.json")
+            with open(path) as f:
+                rec = json.load(f)
+            rec["readings"][0]["ratio"] = 9.875
+            with open(path, "w") as f:
+                json.dump(rec, f)
+            self.assertIn("forces 9.875 (1.744–2.707)", experiments_table.render(experiments_table.load(d)))
+            check = [sys.executable, os.path.join(ANALYSIS, "experiments_table.py"), "--check", "--folder", d]
+            self.assertEqual(subprocess.run(check, stderr=subprocess.DEVNULL).returncode, 1)
+            del rec["cpu"]
+            with open(path, "w") as f:
+                json.dump(rec, f)
+            with self.assertRaisesRegex(ValueError, "missing cpu"):
+                experiments_table.load(d)
+
+
+class Docs(unittest.TestCase):
+    """The pages a reader reads: no figure left in a commit message, every relative link resolves, pages short."""
+    ROOT = os.path.normpath(os.path.join(HERE, os.pardir))
+    # Phrases that send a reader to a commit message (git's history) for a figure.
+    TO_A_MESSAGE = re.compile(r"commit'?s?'? messages?|messages? of the commits?|readings are in the", re.I)
+
+    def pages(self):
+        docs = os.path.join(self.ROOT, "docs")
+        found = [os.path.join(self.ROOT, "README.md")]
+        for folder, _, names in os.walk(docs):
+            found += [os.path.join(folder, n) for n in sorted(names) if n.endswith(".md")]
+        return found
+
+    def test_no_page_points_to_a_commit_message(self):
+        # the pattern catches the sentences the pages used to hold, so that the check can fail
+        for old in ("the readings are in the message of the commit that made the change",
+                    "the commit's message has the paired readings", "in the messages of the commits that added"):
+            self.assertRegex(old, self.TO_A_MESSAGE)
+        for page in self.pages():
+            with open(page, encoding="utf-8") as f:
+                for n, line in enumerate(f, 1):
+                    self.assertIsNone(self.TO_A_MESSAGE.search(line), f"{os.path.relpath(page, self.ROOT)}:{n}: {line.strip()}")
+
+    def test_no_file_cites_an_issue_number(self):
+        """A reader of the repository cannot see the issues: comments and pages say why, not which issue."""
+        if not os.path.isdir(os.path.join(self.ROOT, ".git")) and not os.path.isfile(os.path.join(self.ROOT, ".git")):
+            self.skipTest("not a git checkout")
+        pattern = "issue" + " [0-9]"  # split, so that this file does not match itself
+        found = subprocess.run(["git", "-C", self.ROOT, "grep", "-n", "-I", pattern], capture_output=True, text=True)
+        self.assertEqual(found.returncode, 1, found.stdout[:2000])  # 1: nothing found
+
+    @staticmethod
+    def anchors(page):
+        """The anchors GitHub makes of a page's headings: lower case, punctuation dropped, spaces as hyphens."""
+        with open(page, encoding="utf-8") as f:
+            heads = [m.group(1).strip().lower() for m in re.finditer(r"^#+ (.*)$", f.read(), flags=re.M)]
+        return {re.sub(r"[^\w\- ]", "", h).replace(" ", "-") for h in heads}
+
+    def test_every_relative_link_resolves(self):
+        link = re.compile(r"\]\(([^)#\s]*)(?:#([^)\s]*))?\)")
+        for page in self.pages():
+            with open(page, encoding="utf-8") as f:
+                text = f.read()
+            for target, anchor in link.findall(text):
+                if re.match(r"[a-z]+:", target):
+                    continue  # a URL
+                path = os.path.normpath(os.path.join(os.path.dirname(page), target)) if target else page
+                name = f"{os.path.relpath(page, self.ROOT)} links {target}#{anchor}"
+                self.assertTrue(os.path.exists(path), f"{name}, which does not exist")
+                if anchor and path.endswith(".md"):
+                    self.assertIn(anchor, self.anchors(path), f"{name}: no such heading")
+
+    def test_pages_are_short(self):
+        for page in self.pages():
+            with open(page, encoding="utf-8") as f:
+                lines = sum(1 for _ in f)
+            limit = 150 if os.sep + "variants" + os.sep in page else 400
+            self.assertLessEqual(lines, limit, os.path.relpath(page, self.ROOT))
 
 
 class ValidationReference(unittest.TestCase):

@@ -132,8 +132,10 @@ TEST(PeerIo, LammpsWallModulusGivesTheSuitesEffectiveModulus)
 }
 
 #ifdef DEMMAT_LAMMPS_EXECUTABLE
-// Runs the exported scene in LAMMPS for `steps` steps and returns its final particles.
-State run_lammps(const Scene& scene, const State& s, std::int64_t steps, const std::string& name)
+// Runs the exported scene in LAMMPS (Debian's binary unless `lmp` names another, with `options` on its
+// command line) for `steps` steps and returns its final particles.
+State run_lammps(const Scene& scene, const State& s, std::int64_t steps, const std::string& name,
+                 const std::string& lmp = DEMMAT_LAMMPS_EXECUTABLE, const std::string& options = "")
 {
     const fs::path dir = scratch_dir(name);
     PeerOptions o;
@@ -143,8 +145,8 @@ State run_lammps(const Scene& scene, const State& s, std::int64_t steps, const s
     write_atomically(dir / (name + ".lammps"), e.lammps);
     write_atomically(dir / "in.test", fmt::format("include {}.lammps\nthermo 0\nrun {}\nwrite_dump all custom final.dump id radius x y z vx vy vz "
                                                   "omegax omegay omegaz modify sort id format float %.17g\n", name, steps));
-    const std::string cmd = fmt::format("cd '{}' && OMP_NUM_THREADS=1 '{}' -in in.test -log none -nocite > lammps.out 2>&1", dir.string(),
-                                        DEMMAT_LAMMPS_EXECUTABLE);
+    const std::string cmd = fmt::format("cd '{}' && OMP_NUM_THREADS=1 '{}' {} -in in.test -log none -nocite > lammps.out 2>&1", dir.string(),
+                                        lmp, options);
     EXPECT_EQ(std::system(cmd.c_str()), 0) << "LAMMPS failed; see " << (dir / "lammps.out");
     State out = import_peer_state(dir / "final.dump", scene);
     fs::remove_all(dir);
@@ -221,8 +223,8 @@ ContactModel history_law(TangentialModel t, bool rolling)
     return m;
 }
 
-// A sphere at (vt, 0, −vn) with spin onto the floor, no gravity; returns suite and LAMMPS after `steps`.
-std::pair<Snapshot, State> oblique_wall_impact(const ContactModel& law, double vt, double vn, double spin, const std::string& name)
+// A sphere at (vt, 0, −vn) with spin onto the floor, no gravity.
+Scene oblique_wall_scene(const ContactModel& law, double vt, double vn, double spin)
 {
     Scene scene = drop_scene(1e-6);
     scene.gravity = {};
@@ -232,9 +234,31 @@ std::pair<Snapshot, State> oblique_wall_impact(const ContactModel& law, double v
     scene.contact_model = law;
     scene.particles[0].velocity = {vt, 0.0, -vn};
     scene.particles[0].angular_velocity = {0.0, spin, 0.0};
-    const std::int64_t steps = 3000;  // the contact lasts about 800 steps
-    const State lammps = run_lammps(scene, initial_state(scene), steps, name);
-    return {run_suite(scene, steps), lammps};
+    return scene;
+}
+constexpr std::int64_t kWallImpactSteps = 3000;  // the contact lasts about 800 steps
+
+// The wall impact run by the suite and by LAMMPS for kWallImpactSteps.
+std::pair<Snapshot, State> oblique_wall_impact(const ContactModel& law, double vt, double vn, double spin, const std::string& name)
+{
+    const Scene scene = oblique_wall_scene(law, vt, vn, spin);
+    const State lammps = run_lammps(scene, initial_state(scene), kWallImpactSteps, name);
+    return {run_suite(scene, kWallImpactSteps), lammps};
+}
+
+// Two spheres meeting off-centre with opposite spins, the linear history and sds rolling laws.
+Scene oblique_pair_scene()
+{
+    Scene scene = head_on_scene(0.5);
+    scene.dt = 2e-6;
+    scene.material.young = 1e7;
+    scene.material.mu = 0.3;
+    scene.contact_model = history_law(TangentialModel::linear_history, true);
+    scene.particles[0].position = {-(0.004 + 1e-6), -0.001, 0.0};
+    scene.particles[1].position = {0.004 + 1e-6, 0.001, 0.0};
+    scene.particles[0].angular_velocity = {0.0, 0.0, 20.0};
+    scene.particles[1].angular_velocity = {0.0, 0.0, -20.0};
+    return scene;
 }
 
 void expect_close(const Vec3d& suite, const Vec3d& lammps, double scale, const char* what)
@@ -259,15 +283,7 @@ TEST(PeerLammps, ObliquePairImpactWithLinearHistoryAndRollingAsInTheSuite)
 {
     // Two spheres meeting off-centre with opposite spins: the tangential spring and the rolling spring
     // both act; the final velocities and spins of both depend on k_t, x_γt, k_r, γ_r and μ_r.
-    Scene scene = head_on_scene(0.5);
-    scene.dt = 2e-6;
-    scene.material.young = 1e7;
-    scene.material.mu = 0.3;
-    scene.contact_model = history_law(TangentialModel::linear_history, true);
-    scene.particles[0].position = {-(0.004 + 1e-6), -0.001, 0.0};
-    scene.particles[1].position = {0.004 + 1e-6, 0.001, 0.0};
-    scene.particles[0].angular_velocity = {0.0, 0.0, 20.0};
-    scene.particles[1].angular_velocity = {0.0, 0.0, -20.0};
+    const Scene scene = oblique_pair_scene();
     const std::int64_t steps = 3000;
     const State lammps = run_lammps(scene, initial_state(scene), steps, "pair_history");
     const Snapshot suite = run_suite(scene, steps);
@@ -277,6 +293,32 @@ TEST(PeerLammps, ObliquePairImpactWithLinearHistoryAndRollingAsInTheSuite)
         expect_close(0.004 * suite.angular_velocity[i], 0.004 * lammps.rot.v[i], 0.5, "spin·R");
     }
 }
+
+#ifdef DEMMAT_LAMMPS_NATIVE
+// The LAMMPS that run_peers.sh times (scripts/build_lammps.sh: -O3 -march=native, GRANULAR, OPENMP) runs
+// the exported laws as Debian's binary does, on one thread and through its OPENMP styles on two: the pair
+// impact (normal, tangential history and rolling terms) and the mindlin wall impact. -O3 -march=native lets
+// GCC fuse multiply-adds, so the last bits may differ (two bodies, no chaos: far below the tolerance); a
+// missing package or a style of another law would stop the run or move the rebound by percents.
+TEST(PeerLammps, TheBuildForTheCpuRunsTheLawsAsDebiansBinary)
+{
+    const Scene pair = oblique_pair_scene();
+    const Scene wall = oblique_wall_scene(history_law(TangentialModel::mindlin, false), 0.1, 0.5, 0.0);
+    for (const auto& [scene, steps, name] : {std::tuple{pair, std::int64_t{3000}, "native_pair"},
+                                             std::tuple{wall, kWallImpactSteps, "native_wall"}}) {
+        const State debian = run_lammps(scene, initial_state(scene), steps, name);
+        for (const char* options : {"", "-sf omp -pk omp 2"}) {
+            const State native = run_lammps(scene, initial_state(scene), steps, name, DEMMAT_LAMMPS_NATIVE, options);
+            ASSERT_EQ(native.size(), debian.size());
+            for (std::size_t i = 0; i < debian.size(); ++i)
+                for (int c = 0; c < 3; ++c) {
+                    EXPECT_NEAR(component(native.trans.v[i], c), component(debian.trans.v[i], c), 1e-9) << name << " " << options;
+                    EXPECT_NEAR(0.004 * component(native.rot.v[i], c), 0.004 * component(debian.rot.v[i], c), 1e-9) << name << " " << options;
+                }
+        }
+    }
+}
+#endif
 #else
 TEST(PeerLammps, SkippedWithoutLammps) { GTEST_SKIP() << "lmp not found at configure time (scripts/install_deps.sh --optional)"; }
 #endif

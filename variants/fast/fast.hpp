@@ -19,17 +19,17 @@ struct FastOptions {
     // to both particles as it is computed (the trajectory differs from arrays in the last bits).
     bool canonical = true;
     // Below this many particles the variant runs on one thread whatever the thread count: a fork and
-    // join per phase costs more than the work it shares (docs/variants.md, "fast"). The tests set 0, so
+    // join per phase costs more than the work it shares (docs/variants/fast.md). The tests set 0, so
     // that their small scenes run on the threads they ask for.
     std::size_t min_parallel = 3000;
-    // From this many particles on the pair kernel prefetches its partners' records (docs/variants.md,
-    // "fast"; a hint to the caches, which changes no result). The tests set 0, so that their small
+    // From this many particles on the pair kernel prefetches its partners' records (docs/variants/engine.md:
+    // a hint to the caches, which changes no result). The tests set 0, so that their small
     // scenes take that path too.
     std::size_t prefetch_from = 8000;
     // From this many particles on, predict()'s pass writes the kernels' records with non-temporal stores
     // (Particles::refresh_records): well past the last-level cache the records leave it before the force
     // pass reads them, and a plain store first reads each line it overwrites; nearer the cache's size
-    // they would have stayed (docs/variants.md, "fast"; no result changes). The tests set 0, so that
+    // they would have stayed (docs/variants/engine.md; no result changes). The tests set 0, so that
     // their small scenes take that path too.
     std::size_t stream_records_from = 48000;
 };

@@ -1,6 +1,6 @@
 #pragma once
 // The fast variant for one model M (model.hpp): data-oriented, vectorised, OpenMP multi-threaded, and
-// still bit-identical to arrays for any number of threads (docs/variants.md, "fast"). This file is the
+// still bit-identical to arrays for any number of threads (docs/variants/fast.md). This file is the
 // Variant: it owns the parts and runs the phases; each part is a header of its own.
 //
 // - particles.hpp: the state in storage (cell) order, a structure of arrays, and predict()'s one pass

@@ -1,4 +1,4 @@
-# The distributed-memory variant (variants/mpi, docs/variants.md "mpi"), only where Open MPI (Debian's
+# The distributed-memory variant (variants/mpi, docs/variants/mpi.md), only where Open MPI (Debian's
 # libopenmpi-dev, scripts/install_deps.sh) is found; elsewhere it is skipped, not failed. It is not in the
 # registry: its ranks must be started by mpirun, so demmat_mpi (app/) and the mpi tests make it directly.
 find_package(MPI COMPONENTS CXX QUIET)

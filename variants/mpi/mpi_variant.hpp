@@ -1,6 +1,6 @@
 #pragma once
 // The mpi variant: the processor spread over the ranks of an MPI communicator by spatial domain
-// decomposition (bricks.hpp), bit-identical to arrays for any number of ranks (docs/variants.md, "mpi").
+// decomposition (bricks.hpp), bit-identical to arrays for any number of ranks (docs/variants/mpi.md).
 // One instance per rank, each driven by its own Driver in lockstep. It is not in the registry (a
 // program that runs it must be started by mpirun): demmat_mpi and the mpi tests make it here.
 //

@@ -1,5 +1,5 @@
 #pragma once
-// The Gear step on a rank's owned particles, as fast does it (docs/variants.md, "fast"): the corrector
+// The Gear step on a rank's owned particles, as fast does it (docs/variants/engine.md): the corrector
 // of one step fused with the predictor of the next in one pass over the Gear arrays (the arrays read and
 // written once instead of twice), with the displacement check of the neighbour list in the same pass.
 // The corrector is the shared Gear5Scheme::correct and the predictor Gear5Scheme::predict, the same

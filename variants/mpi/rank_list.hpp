@@ -1,5 +1,5 @@
 #pragma once
-// A rank's neighbour list (docs/variants.md, "mpi"): every pair with an owned particle closer than
+// A rank's neighbour list (docs/variants/mpi.md): every pair with an owned particle closer than
 // R_i + R_j + skin, found by the linked cells over owned particles and ghosts, each pair once with the
 // lower id as i (`pairs`: first the pairs whose i this rank owns, so that a contact is counted once
 // over all ranks, in the order of the owned particle that found them; then the few whose i is a ghost);

@@ -1,5 +1,5 @@
 #pragma once
-// The phases on one rank (docs/variants.md, "mpi"), for model M (model.hpp), gear5 in double:
+// The phases on one rank (docs/variants/mpi.md), for model M (model.hpp), gear5 in double:
 //
 //   predict  the pending corrector and the Gear predictor on the owned particles in one pass, and the
 //            displacement check (rank_gear.hpp); moving walls placed from the step number (every rank

@@ -186,10 +186,9 @@ public:
     // (sum_particles, which looks its slots up in the lists, for the sums that read two rings or the
     // list of all slots, which the tables' ring places cannot name).
     // Where vectors have eight lanes (AVX-512) a particle's force and torque are one vector, and each
-    // slot it reads one load of its line (sum_group_eight); narrower (AVX2), such a vector is two
-    // registers, and four sums with their inputs no longer fit the sixteen: GCC keeps them on the stack.
-    // There the force and the torque are a quad each (sum_group_quads), which fit. The same additions
-    // either way, lane by lane.
+    // slot it reads one load of its line (sum_group_eight). Where they are narrower, a vector of eight
+    // is two registers and four sums with their inputs would not fit the register file, so the force
+    // and the torque are a quad each (sum_group_quads). The same additions either way, lane by lane.
     void sum_group(const Schedule& from, const Group& g, const SlotView& ring, const WallContacts& walls, Particles& p) const
     {
         if constexpr (kLanes >= 8)

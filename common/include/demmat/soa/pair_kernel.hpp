@@ -102,7 +102,7 @@ public:
     // each slot kPrefetch candidates ahead (and in fast_unordered its load): a slot is stored with the
     // pair's particle that comes first in storage, whose records come in order, which the hardware
     // prefetches; the other (the later, max(owner, partner)) lies anywhere in the sweep's reach, which it
-    // does not, and in large beds the records no longer stay in the caches between force passes.
+    // does not, and a large bed's records do not stay in the caches from one force pass to the next.
     static constexpr std::size_t kPrefetch = 128;
 
     PairKernel(const NeighbourList& list, const Particles& p, const LawInputs& law, Quad* stretches, bool prefetch)

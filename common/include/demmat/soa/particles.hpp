@@ -2,7 +2,7 @@
 // The fast variant's particles in storage (cell) order: the Gear state as a structure of arrays, each
 // vector quantity three contiguous component blocks (x then y then z) as in arrays, the step's forces,
 // and the kernels' records. predict()'s pass runs here, a block at a time: the corrector of one step
-// fused with the predictor of the next, the displacement check, the records (docs/variants.md, "fast").
+// fused with the predictor of the next, the displacement check, the records (docs/variants/engine.md).
 #include <algorithm>
 #include <array>
 #include <cstddef>

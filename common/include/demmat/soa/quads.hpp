@@ -1,5 +1,5 @@
 #pragma once
-// The fast variant's unit of data movement (docs/variants.md, "fast"): a quad, four doubles loaded and
+// The fast variant's unit of data movement (docs/variants/engine.md): a quad, four doubles loaded and
 // stored as one vector, and the transposes that move a pack's worth of per-particle quads into the
 // lanes of the law (one lane per pair) and back. They move bits and compute nothing.
 #include <cstdint>
