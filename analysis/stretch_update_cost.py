@@ -45,7 +45,7 @@ def table(df, prov, meta):
              "| law | stage | first_order µs | trapezoidal µs | ratio | contacts per particle (first_order, trapezoidal) | rounds |",
              "|---|---|---|---|---|---|---|"]
     for (law, stage), g in df.groupby(["law", "stage"], sort=False):
-        by = {u: g[g.update == u].set_index("round") for u in ("first_order", "trapezoidal")}
+        by = {u: g[g["update"] == u].set_index("round") for u in ("first_order", "trapezoidal")}
         rounds = sorted(set(by["first_order"].index) & set(by["trapezoidal"].index))
         ratios = [by["trapezoidal"].us[r] / by["first_order"].us[r] for r in rounds]
         lines.append(f"| {law} | {stage} | {by['first_order'].us.median():.4f} | {by['trapezoidal'].us.median():.4f} | "
