@@ -66,4 +66,11 @@ inline CLI::Validator number_from(double lo, bool open)
     return CLI::Validator(check, fmt::format("NUMBER {} {:g}", open ? ">" : ">=", lo));
 }
 
+// A file or folder name: given, so not empty (`--json ''` would otherwise silently write nothing).
+inline CLI::Validator path_given()
+{
+    return CLI::Validator([](std::string& text) -> std::string { return text.empty() ? "an empty name; give a file or folder name" : ""; },
+                          "PATH");
+}
+
 } // namespace demmat

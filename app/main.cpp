@@ -54,9 +54,12 @@ std::unique_ptr<Problem> load(const std::string& file, bool allow_unstable, cons
     Scene scene = load_scene(file);
     if (prepare) prepare(scene);
     auto l = std::make_unique<Problem>(std::move(scene));
+    if (const std::string w = check_continued_walls(l->scene(), l->state()); !w.empty()) std::cerr << "demmat: warning: " << w << "\n";
     if (!allow_unstable) {
         const std::string warning = check_time_step(l->scene(), l->state());
         if (!warning.empty()) std::cerr << "demmat: warning: " << warning << "\n";
+    } else {
+        check_magnitudes(l->scene(), l->state());  // what no run survives, --allow-unstable or not
     }
     return l;
 }
@@ -116,23 +119,32 @@ struct RunArgs {
 
 // Every output of `demmat run`, checked before the run: none is a directory or an input, each can be
 // written, and no two are the same file.
+// '-' as --json or --log: standard output (the run's report then goes to standard error).
+bool to_stdout(const std::string& file) { return file == "-"; }
+// An output given as a file (not absent, not standard output).
+bool to_file(const std::string& file) { return !file.empty() && !to_stdout(file); }
+
 void check_run_outputs(const RunArgs& a, const Scene& s)
 {
+    if (to_stdout(a.json_file) && to_stdout(a.log_file))
+        throw Error("--json - and --log - both ask for standard output; give one of them a file name");
+    if (to_stdout(a.save_file)) throw Error("--save -: a state file is binary, not written to standard output; give a file name");
     const auto inputs = scene_inputs(s);
-    if (!a.json_file.empty()) check_output_path(a.json_file, "--json", inputs);
-    if (!a.save_file.empty()) check_output_path(a.save_file, "--save", inputs);
-    if (!a.json_file.empty() && !a.save_file.empty() && same_file(a.json_file, a.save_file))
+    if (to_file(a.json_file)) check_output_path(a.json_file, "--json", inputs);
+    if (to_file(a.save_file)) check_output_path(a.save_file, "--save", inputs);
+    if (to_file(a.json_file) && to_file(a.save_file) && same_file(a.json_file, a.save_file))
         throw Error(fmt::format("--json and --save name the same file {}", a.json_file));
     if (!a.vtk_dir.empty()) {
         check_output_folder(a.vtk_dir, "--vtk");
         const fs::path pvd = fs::path(a.vtk_dir) / (safe_file_stem(s.name) + ".pvd");
         check_output_path(pvd, "--vtk", inputs);
         for (const std::string* f : {&a.json_file, &a.save_file, &a.log_file})
-            if (!f->empty() && same_file(*f, pvd)) throw Error(fmt::format("{} is also the VTK series of --vtk", *f));
+            if (to_file(*f) && same_file(*f, pvd)) throw Error(fmt::format("{} is also the VTK series of --vtk", *f));
     }
     if (!a.log_file.empty()) {
         for (const std::string* f : {&a.json_file, &a.save_file})
-            if (!f->empty() && same_file(*f, a.log_file)) throw Error(fmt::format("--log and another output name the same file {}", *f));
+            if (to_file(*f) && to_file(a.log_file) && same_file(*f, a.log_file))
+                throw Error(fmt::format("--log and another output name the same file {}", *f));
         // The log evaluates energies and wall forces with the paper's law (it has no access to the
         // variant's stretches): under a law of physics.md §9 its columns would be wrong, so it refuses.
         if (!s.contact_model.is_paper())
@@ -153,8 +165,17 @@ int cmd_run(const RunArgs& a)
         check_run_outputs(a, s);
     });
     const std::int64_t steps = steps_for(l->scene(), a.steps, a.time);
+    // Files named after the scene's name, made safe: a name such as "../../x" stays inside the folder.
+    const std::string vtk_stem = safe_file_stem(l->scene().name);
+    if (!a.vtk_dir.empty()) {  // every snapshot name of the run, now that its first step is known
+        auto others = scene_inputs(l->scene());
+        for (const auto& [f, what] : {std::pair{a.json_file, "the --json file"}, {a.save_file, "the --save file"}, {a.log_file, "the --log file"}})
+            if (to_file(f)) others.emplace_back(f, what);
+        check_vtk_names(a.vtk_dir, vtk_stem, l->state().step, l->state().step + steps, others);
+    }
     auto variant = info.create();
     Driver driver(*variant, l->setup());
+    std::ostream& report = to_stdout(a.json_file) || to_stdout(a.log_file) ? std::cerr : std::cout;
 
     std::unique_ptr<VtkSeries> vtk;
     Snapshot snap;
@@ -169,8 +190,6 @@ int cmd_run(const RunArgs& a)
         variant->snapshot(snap);
         vtk->write(snap, l->state().radius, driver.time());
     };
-    // Files named after the scene's name, made safe: a name such as "../../x" stays inside the folder.
-    const std::string vtk_stem = safe_file_stem(l->scene().name);
     if (!a.vtk_dir.empty()) {
         vtk = std::make_unique<VtkSeries>(a.vtk_dir, vtk_stem, l->scene().domain, l->state().walls, l->scene().dt);
         write_vtk();
@@ -219,26 +238,26 @@ int cmd_run(const RunArgs& a)
     const double n = double(l->state().size());
     const double ke = kinetic_energy(snap, l->setup());
     const PhaseTimes t = driver.times().per_step(steps);
-    std::cout << fmt::format("variant {}  scene {}  particles {}  steps {}  t = {:.6g} s\n", info.name, l->scene().name,
+    report << fmt::format("variant {}  scene {}  particles {}  steps {}  t = {:.6g} s\n", info.name, l->scene().name,
                              l->state().size(), steps, driver.time());
-    std::cout << fmt::format("integrator {}\n", l->scene().integrator.describe());
+    report << fmt::format("integrator {}\n", l->scene().integrator.describe());
     if (!l->scene().contact_model.is_paper())
-        std::cout << "contact law " << describe_law(l->scene().contact_model, l->setup().memory) << "\n";
+        report << "contact law " << describe_law(l->scene().contact_model, l->setup().memory) << "\n";
     // The model instantiation the variant picked in init() (docs/design.md, "Model features").
-    std::cout << fmt::format("model {}  (the scene needs {})\n", variant->model().name(),
+    report << fmt::format("model {}  (the scene needs {})\n", variant->model().name(),
                              features_of(l->scene(), l->state()).name());
-    std::cout << fmt::format("steps per second {:.1f}  ({:.4f} us per particle-step)\n", 1.0 / t.total(),
+    report << fmt::format("steps per second {:.1f}  ({:.4f} us per particle-step)\n", 1.0 / t.total(),
                              t.total() / n * 1e6);
-    std::cout << fmt::format("per step: predict {:.3e} s  search {:.3e} s  forces {:.3e} s  correct {:.3e} s  total {:.3e} s\n",
+    report << fmt::format("per step: predict {:.3e} s  search {:.3e} s  forces {:.3e} s  correct {:.3e} s  total {:.3e} s\n",
                              t.predict, t.search, t.forces, t.correct, t.total());
-    std::cout << fmt::format("contacts per particle {:.3f} (particle-particle {}, particle-wall {})  kinetic energy {:.6e} J\n",
+    report << fmt::format("contacts per particle {:.3f} (particle-particle {}, particle-wall {})  kinetic energy {:.6e} J\n",
                              c.per_particle(l->size()), c.particle_particle, c.particle_wall, ke);
     // Sampled: measured at the health checks only (every checks.interval steps and the last), not every step.
     if (l->scene().checks.interval > 0)
-        std::cout << fmt::format("largest overlap at the health checks (sampled every {} steps and at the last) {:.3g} of the "
+        report << fmt::format("largest overlap at the health checks (sampled every {} steps and at the last) {:.3g} of the "
                                  "smaller radius (bound {})\n",
                                  l->scene().checks.interval, driver.largest_overlap_ratio(), l->scene().checks.max_overlap_ratio);
-    std::cout << fmt::format("PERFORMANCE variant={} particles={} steps={} us_per_particle_step={:.5f} seconds={:.4f}\n",
+    report << fmt::format("PERFORMANCE variant={} particles={} steps={} us_per_particle_step={:.5f} seconds={:.4f}\n",
                              info.name, l->state().size(), steps, t.total() / n * 1e6, wall);
 
     if (!a.save_file.empty()) {
@@ -266,7 +285,8 @@ int cmd_run(const RunArgs& a)
                   {"largest_overlap_ratio", driver.largest_overlap_ratio()},  // sampled at the health checks
                   {"largest_overlap_sampled_every_steps", l->scene().checks.interval},  // 0: no checks, no sample
                   {"memory_bytes", variant->memory_bytes()}};
-        write_atomically(a.json_file, j.dump(2) + "\n");
+        if (to_stdout(a.json_file)) std::cout << j.dump(2) << "\n" << std::flush;
+        else write_atomically(a.json_file, j.dump(2) + "\n");
     }
     return 0;
 }
@@ -321,6 +341,8 @@ std::vector<int> thread_counts(const std::string& spec)
 {
     const int fallback = max_threads();
     std::vector<int> out;
+    if (spec.empty() || spec.front() == ',' || spec.back() == ',' || spec.find(",,") != std::string::npos)
+        throw Error(fmt::format("--threads '{}': an empty item in the list (thread counts separated by single commas)", spec));
     for (const std::string& item : split_list(spec)) {
         std::size_t used = 0;
         int t = -1;
@@ -462,19 +484,55 @@ struct SceneArgs {
     std::vector<std::string> contact;  // --contact KEY=VALUE: the [contact] table (physics.md §9)
     ChungOoiCase chung_ooi = no_test();  // chung-ooi (test 0: --test not given): --test, --material, --value, --law, --per-tc
     bool chung_ooi_value = false;      // --value given (else the test's first)
+    std::vector<std::string> given;    // the options given, by their long names
 };
+
+// The options each kind of scene reads (besides --out): any other option given is refused, never ignored.
+void check_scene_options(const SceneArgs& a)
+{
+    static const std::map<std::string, std::vector<std::string>> takes = {
+        {"paper", {"--n", "--seed", "--contact"}},
+        {"dense-bed", {"--n", "--seed", "--max-layers", "--contact"}},
+        {"head-on", {"--speed", "--contact"}},
+        {"drop", {"--gap", "--contact"}},
+        {"chung-ooi", {"--test", "--material", "--value", "--law", "--per-tc"}},
+        {"compression", {"--from", "--state", "--speed", "--contact"}},
+        {"settled", {"--from", "--state", "--contact"}}};
+    const auto it = takes.find(a.kind);
+    if (it == takes.end()) return;  // an unknown kind is named by cmd_scene
+    for (const std::string& opt : a.given)
+        if (opt != "--out" && std::find(it->second.begin(), it->second.end(), opt) == it->second.end())
+            throw Error(fmt::format("scene {} does not use {} (it takes {} and --out)", a.kind, opt, fmt::join(it->second, ", ")));
+    if (a.kind == "chung-ooi" && a.chung_ooi_value && a.chung_ooi.test >= 1 && a.chung_ooi.test <= 8 &&
+        chung_ooi_test(a.chung_ooi.test).sweep == ChungOoiSweep::none)
+        throw Error(fmt::format("scene chung-ooi --test {} sweeps nothing: --value has no meaning for it", a.chung_ooi.test));
+}
+
+// Checking a scene makes its grains (the state and the t = 0 force pass, about this many bytes each):
+// a count this machine cannot hold is refused at once rather than by the out-of-memory killer.
+constexpr double kBytesPerGrainToCheck = 384.0;
+void check_memory_for(std::int64_t grains)
+{
+    const double need = double(grains) * kBytesPerGrainToCheck;
+    const double have = double(::sysconf(_SC_PHYS_PAGES)) * double(::sysconf(_SC_PAGE_SIZE));
+    if (have > 0.0 && need > have)
+        throw Error(fmt::format("--n {}: checking the scene makes its grains, about {:.0f} GB at {:.0f} bytes a grain, more than this "
+                                "machine's {:.0f} GB of memory", grains, need / 1e9, kBytesPerGrainToCheck, have / 1e9));
+}
 
 // Writes a scene only if `demmat run` would accept it: the options are checked by their validators (--n
 // >= 1, --speed > 0, --gap >= 0, finite), and the scene itself by making its initial state (particles in
 // the domain, apart, clear of the walls; a state file of this scene) and checking Δt as run does.
 int cmd_scene(const SceneArgs& a)
 {
-    if (!a.out.empty()) {
+    check_scene_options(a);
+    if (!a.out.empty() && !to_stdout(a.out)) {
         std::vector<NamedPath> inputs;
         if (!a.from.empty()) inputs.emplace_back(a.from, "scene file");
         if (!a.state.empty()) inputs.emplace_back(a.state, "state file");
         check_output_path(a.out, "--out", inputs);
     }
+    if ((a.kind == "paper" || a.kind == "dense-bed") && a.count > 0) check_memory_for(a.count);
     Scene s;
     if (a.kind == "paper") s = paper_scene(a.count > 0 ? a.count : 1000, a.seed);
     else if (a.kind == "dense-bed") s = dense_bed_scene(a.count > 0 ? a.count : 2000, a.seed, a.max_layers);
@@ -487,12 +545,18 @@ int cmd_scene(const SceneArgs& a)
         if (!a.chung_ooi_value) c.value = chung_ooi_test(c.test).values.front();
         s = chung_ooi_scene(c);
     }
-    else if (a.kind == "compression") {
-        if (a.from.empty() || a.state.empty()) throw Error("scene compression needs --from SCENE and --state STATE");
-        s = compression_scene(load_scene(a.from), a.state, a.speed > 0.0 ? a.speed : 0.5);
-    } else if (a.kind == "settled") {
-        if (a.from.empty() || a.state.empty()) throw Error("scene settled needs --from SCENE and --state STATE");
-        s = settled_scene(load_scene(a.from), a.state);
+    else if (a.kind == "compression" || a.kind == "settled") {
+        if (a.from.empty() || a.state.empty()) throw Error(fmt::format("scene {} needs --from SCENE and --state STATE", a.kind));
+        const Scene from = load_scene(a.from);
+        // The state must hold the grains of the scene it continues (the fingerprint binds its materials,
+        // Δt and gravity to its own count, so a state of 2000 grains would pass for a scene of 1).
+        const std::size_t from_count = from.grid ? std::size_t(from.grid->count)
+                                     : from.state_file.empty() ? from.particles.size() : load_state(from.state_file).size();
+        const std::size_t state_count = load_state(a.state).size();
+        if (from_count != state_count)
+            throw Error(fmt::format("--state {} holds {} particles, but --from {} makes {}: the state was not saved from this scene",
+                                    a.state, state_count, a.from, from_count));
+        s = a.kind == "compression" ? compression_scene(from, a.state, a.speed > 0.0 ? a.speed : 0.5) : settled_scene(from, a.state);
     } else {
         throw Error(fmt::format("unknown scene kind '{}' (expected paper, dense-bed, settled, compression, head-on, drop or chung-ooi)", a.kind));
     }
@@ -500,14 +564,20 @@ int cmd_scene(const SceneArgs& a)
     {
         const State state = initial_state(s);
         check_time_step(s, state);  // throws above the stability limit; its warnings are run's to give
+        // A continued scene names its walls where the state has them, so that the file says what a run does.
+        if (!s.state_file.empty())
+            for (std::size_t w = 0; w < s.walls.size(); ++w) {
+                s.walls[w].point = state.walls[w].point_at(state.step, s.dt);
+                s.walls[w].normal = state.walls[w].normal;
+            }
     }
-    if ((a.kind == "compression" || a.kind == "settled") && !a.out.empty()) {  // the state path relative to the new scene file, so the pair can move together
+    if ((a.kind == "compression" || a.kind == "settled") && !a.out.empty() && !to_stdout(a.out)) {  // the state path relative to the new scene file, so the pair can move together
         std::error_code ec;
         const fs::path rel = fs::relative(fs::absolute(a.state), fs::absolute(fs::path(a.out)).parent_path(), ec);
         if (!ec && !rel.empty()) s.state_file = rel;
     }
     const std::string text = scene_to_toml(s);
-    if (a.out.empty()) std::cout << text;
+    if (a.out.empty() || to_stdout(a.out)) std::cout << text;
     else write_atomically(a.out, text);
     return 0;
 }
@@ -531,17 +601,18 @@ int main(int argc, char** argv)
     SceneArgs sa;
     auto* scene = app.add_subcommand("scene", "Write a standard scene as an editable TOML file (to stdout without --out)");
     scene->add_option("kind", sa.kind, "paper | dense-bed | settled | compression | head-on | drop | chung-ooi")->required();
-    scene->add_option("--out,-o", sa.out, "Output file");
+    scene->add_option("--out,-o", sa.out, "Output file (default, or -: standard output)")->check(path_given());
     constexpr std::int64_t int_max = 2147483647, int64_max = std::numeric_limits<std::int64_t>::max();
-    scene->add_option("--n", sa.count, "Number of particles (paper: 1000, dense-bed: 2000)")
+    scene->add_option("--n", sa.count, "Number of particles (paper: 1000, dense-bed: 2000; at most what this machine's memory holds, "
+                                       "about 384 bytes a grain)")
         ->check(integer_in(1, int_max, "32-bit particle indices"));
     scene->add_option("--seed", sa.seed, "Seed of the particle generator")->check(integer_in(0, int64_max));
     scene->add_option("--max-layers", sa.max_layers, "dense-bed: at most this many lattice layers; more grains make the bed wider")
         ->check(integer_in(1, int_max));
     scene->add_option("--speed", sa.speed, "head-on: relative speed (m/s); compression: wall speed (m/s)")->check(number_from(0.0, true));
     scene->add_option("--gap", sa.gap, "drop: initial gap between the sphere and the wall (m)")->check(number_from(0.0, false));
-    scene->add_option("--from", sa.from, "settled, compression: the scene that was settled");
-    scene->add_option("--state", sa.state, "settled, compression: the settled state file");
+    scene->add_option("--from", sa.from, "settled, compression: the scene that was settled")->check(path_given());
+    scene->add_option("--state", sa.state, "settled, compression: the settled state file")->check(path_given());
     scene->add_option("--test", sa.chung_ooi.test, "chung-ooi: the test, 1 to 8 (docs/validation.md)")->check(integer_in(1, 8));
     scene->add_option("--material", sa.chung_ooi.material, "chung-ooi: the test's material (default its first)");
     scene->add_option("--value", sa.chung_ooi.value, "chung-ooi: the swept value (e, angle in degrees, tangential speed or spin; default the first)")
@@ -556,13 +627,14 @@ int main(int argc, char** argv)
     run->add_option("--variant,-v", ra.variant, "Variant name (see demmat list)");
     auto* steps_opt = run->add_option("--steps,-n", ra.steps, "Number of steps")->check(integer_in(1, kMaxSteps));
     run->add_option("--time,-t", ra.time, "Simulated time (s), instead of --steps")->excludes(steps_opt)->check(number_from(0.0, true));
-    run->add_option("--json", ra.json_file, "Write the summary as JSON with provenance");
-    run->add_option("--save", ra.save_file, "Save the final state (continue with particles.source = \"state\")");
+    run->add_option("--json", ra.json_file, "Write the summary as JSON with provenance (-: to standard output, the report to standard error)")->check(path_given());
+    run->add_option("--save", ra.save_file, "Save the final state (continue with particles.source = \"state\")")->check(path_given());
     run->add_option("--vtk", ra.vtk_dir, "Write VTK snapshots (particles and walls) and a .pvd series (ParaView) into this folder, "
                                           "named after the scene (characters other than letters, digits, '-', '_', '.' become '_'); "
-                                          "on a blow-up the series ends with the failing step");
+                                          "on a blow-up the series ends with the failing step")->check(path_given());
     run->add_option("--vtk-every", ra.vtk_every, "Steps between VTK snapshots (0: first and last only)")->check(integer_in(0, kMaxSteps));
-    auto* log_opt = run->add_option("--log", ra.log_file, "Write a CSV time series (energies, contacts, overlap, wall forces)");
+    auto* log_opt = run->add_option("--log", ra.log_file, "Write a CSV time series (energies, contacts, overlap, wall forces; -: to standard output)")
+                        ->check(path_given());
     run->add_option("--log-every", ra.log_every, fmt::format("Steps between rows of --log (default {})", kDefaultLogEvery))->needs(log_opt);
     run->add_flag("--quiet,-q", ra.quiet, "No progress on stderr");
     run->add_flag("--allow-unstable", ra.allow_unstable, "Run even with a time step above the Rayleigh time, without warning");
@@ -593,12 +665,18 @@ int main(int argc, char** argv)
     bench->add_option("--steps,-n", ba.steps, "Timed steps per repetition")->check(integer_in(1, kMaxSteps));
     bench->add_option("--repetitions,-r", ba.repetitions, "Repetitions")->check(integer_in(1, int_max));
     bench->add_option("--warmup", ba.warmup, "Untimed steps before each repetition")->check(integer_in(0, kMaxSteps));
-    bench->add_option("--json", ba.json_file, "Write the samples and medians as JSON with provenance");
+    bench->add_option("--json", ba.json_file, "Write the samples and medians as JSON with provenance")->check(path_given());
     bench->add_flag("--allow-unstable", ba.allow_unstable, "Run even with a time step above the Rayleigh time, without warning");
     bench->add_option("--threads", ba.threads,
                       "Comma-separated thread counts for the threaded variants, timed interleaved (e.g. 1,2); 0: OpenMP's default");
 
     remove_partial_files_on_signal();
+    std::vector<std::string> names;
+    for (const CLI::App* sub : app.get_subcommands([](const CLI::App*) { return true; })) names.push_back(sub->get_name());
+    if (argc > 1 && argv[1][0] != '-' && std::find(names.begin(), names.end(), argv[1]) == names.end()) {  // CLI11: "A subcommand is required"
+        std::cerr << fmt::format("demmat: error: unknown subcommand '{}' (expected {}; see demmat --help)\n", argv[1], fmt::join(names, ", "));
+        return 2;
+    }
     try {
         app.parse(argc, argv);
     } catch (const CLI::CallForHelp& e) {
@@ -612,6 +690,8 @@ int main(int argc, char** argv)
         return 2;
     }
     set_threads(threads);
+    for (const CLI::Option* opt : scene->get_options())
+        if (opt->count() > 0 && opt->nonpositional()) sa.given.push_back(opt->get_name());
 
     try {
         if (*list) {

@@ -245,8 +245,8 @@ int main(int argc, char** argv)
     auto* run = app.add_subcommand("run", "Run a scene with the mpi variant and report per-phase times and the decomposition");
     add_common(run);
     run->add_option("--variant,-v", a.variant, "Variant name (mpi only)");
-    run->add_option("--json", a.json_file, "Write the summary as JSON with provenance");
-    run->add_option("--save", a.save_file, "Save the final state, gathered on rank 0 (it continues at any process count)");
+    run->add_option("--json", a.json_file, "Write the summary as JSON with provenance")->check(path_given());
+    run->add_option("--save", a.save_file, "Save the final state, gathered on rank 0 (it continues at any process count)")->check(path_given());
     run->add_flag("--quiet,-q", a.quiet, "No progress on stderr");
     auto* compare = app.add_subcommand("compare", "Run the mpi variant beside a reference variant on rank 0 and check every step bit for bit");
     add_common(compare);
@@ -256,7 +256,7 @@ int main(int argc, char** argv)
     bench->add_option("--variants,--variant", a.variant, "Variant name (mpi only)");
     bench->add_option("--repetitions,-r", a.repetitions, "Repetitions")->check(integer_in(1, 1000000));
     bench->add_option("--warmup", a.warmup, "Untimed steps before each repetition")->check(integer_in(0, kMaxSteps));
-    bench->add_option("--json", a.json_file, "Write the samples and medians as JSON with provenance");
+    bench->add_option("--json", a.json_file, "Write the samples and medians as JSON with provenance")->check(path_given());
     bench->get_option("--steps")->default_val(200);
     for (const char* name : {"scene", "export-lammps", "import-lammps", "dump"})
         app.add_subcommand(name, "(runs on one process: use demmat)")->allow_extras();

@@ -1,9 +1,7 @@
 #include "peer_commands.hpp"
 
-#include <cerrno>
-#include <cstdio>
-#include <cstring>
-#include <fstream>
+#include <algorithm>
+
 #include <iostream>
 #include <limits>
 
@@ -38,8 +36,8 @@ PeerCommands::PeerCommands(CLI::App& app) : a_(std::make_unique<Args>())
     a.exp = app.add_subcommand("export-lammps",
                                "Write a scene's particles as a LAMMPS data file, with LAMMPS and LIGGGHTS input fragments (docs/peers.md)");
     a.exp->add_option("scene", a.scene, "Scene file (TOML)")->required();
-    a.exp->add_option("--state", a.state, "Take the particles from this state file instead of the scene's own source");
-    a.exp->add_option("--out,-o", a.out, "Data file to write (NAME.data); beside it NAME.lammps, NAME.liggghts, NAME_<wall>.stl")->required();
+    a.exp->add_option("--state", a.state, "Take the particles from this state file instead of the scene's own source")->check(path_given());
+    a.exp->add_option("--out,-o", a.out, "Data file to write (NAME.data); beside it NAME.lammps, NAME.liggghts, NAME_<wall>.stl")->required()->check(path_given());
     a.exp->add_option("--perturb", a.perturb, "Add random velocities with components uniform in [-A, A] m/s (an ensemble member)")
         ->check(number_from(0.0, false));
     a.exp->add_option("--seed", a.seed, "Seed of the perturbation")->check(integer_in(0, std::numeric_limits<std::int64_t>::max()));
@@ -48,17 +46,17 @@ PeerCommands::PeerCommands(CLI::App& app) : a_(std::make_unique<Args>())
     a.imp = app.add_subcommand("import-lammps", "Read a LAMMPS data file or dump (last frame) into a state file for a scene");
     a.imp->add_option("file", a.state, "LAMMPS data file or text dump")->required();
     a.imp->add_option("--scene", a.scene, "The scene the particles belong to (materials, walls, time step)")->required();
-    a.imp->add_option("--out,-o", a.out, "State file to write")->required();
+    a.imp->add_option("--out,-o", a.out, "State file to write")->required()->check(path_given());
 
     a.dump = app.add_subcommand("dump", "Run a scene with one variant and write LAMMPS-style dump frames (id radius x v omega)");
     a.dump->add_option("scene", a.scene, "Scene file (TOML)")->required();
-    a.dump->add_option("--state", a.state, "Start from this state file instead of the scene's own source");
+    a.dump->add_option("--state", a.state, "Start from this state file instead of the scene's own source")->check(path_given());
     a.dump->add_option("--variant,-v", a.variant, "Variant name (see demmat list)");
     a.dump->add_option("--steps,-n", a.steps, "Number of steps")->check(integer_in(1, kMaxSteps));
     a.dump->add_option("--every", a.every, "Steps between frames (the first frame is the initial state; frames carry the "
                                            "scene's step, continued from a state file's)")->check(integer_in(1, kMaxSteps));
     a.dump->add_option("--integrator", a.integrator, "gear5 | gear3 | verlet | symplectic_euler (overrides the scene's [integrator])");
-    a.dump->add_option("--out,-o", a.out, "Dump file to write")->required();
+    a.dump->add_option("--out,-o", a.out, "Dump file to write")->required()->check(path_given());
     a.dump->add_flag("--allow-unstable", a.allow_unstable, "Run even with a time step above the integrator's stability limit, without warning");
 }
 
@@ -97,7 +95,17 @@ int cmd_export(const std::string& scene_file, const std::string& state_file, con
         check_output_path(data.parent_path() / (data.stem().string() + ext), "--out", inputs);
     check_output_path(data, "--out", inputs);
     State state = initial_state(scene);
-    if (perturb > 0.0) perturb_velocities(state, perturb, seed);
+    const Vec3d side = scene.domain.max - scene.domain.min;
+    if (skin > std::max({side.x, side.y, side.z}))
+        throw Error(fmt::format("--skin {:g} m is larger than the domain itself (its largest side is {:g} m)", skin, std::max({side.x, side.y, side.z})));
+    if (perturb > 0.0) {
+        perturb_velocities(state, perturb, seed);
+        try {  // the perturbed grains must still make a run the time-step check accepts
+            check_time_step(scene, state);
+        } catch (const Error& e) {
+            throw Error(fmt::format("--perturb {:g} m/s: the perturbed velocities fail the time-step check: {}", perturb, e.what()));
+        }
+    }
     PeerOptions o;
     o.data_name = data.filename().string();
     o.mesh_prefix = data.stem().string();
@@ -130,46 +138,29 @@ int cmd_dump(const std::string& scene_file, const std::string& state_file, const
     override_integrator(scene, integrator, {});
     use_state_file(scene, state_file);
     check_output_path(out, "--out", inputs_of(scene));
-    check_output_path(out + ".part", "--out", inputs_of(scene));
     const State state = initial_state(scene);
     if (!allow_unstable) {  // the time step against the chosen integrator's limit, as run checks it
         const std::string warning = check_time_step(scene, state);
         if (!warning.empty()) std::cerr << "demmat: warning: " << warning << "\n";
+    } else {
+        check_magnitudes(scene, state);
     }
     const Setup setup = Setup::make(scene, state);
     auto variant = registry().find(variant_name).create();
     Driver driver(*variant, setup);
-    // Frames go to a temporary file beside the target, renamed at the end: complete or absent.
-    const fs::path target = out;
-    const fs::path tmp = target.string() + ".part";
-    if (target.has_parent_path()) {
-        std::error_code ec;
-        fs::create_directories(target.parent_path(), ec);  // as write_atomically does for every other output
-    }
-    {
-        std::ofstream f(tmp);
-        if (!f) throw Error(fmt::format("{}: cannot write: {}", tmp.string(), std::strerror(errno)));
+    // The run happens inside the one atomic writer of every output (a fresh temporary file, removed on an
+    // error or a signal, renamed into place at the end): the dump is complete or absent.
+    write_atomically(out, [&](std::ostream& f) {
         Snapshot snap;
         auto frame = [&](std::int64_t k) {
             variant->snapshot(snap);
             f << lammps_dump_frame(k, scene, state.radius, snap.position, snap.velocity, snap.angular_velocity);
+            if (!f) throw Error(fmt::format("{}: write failed (disk full?)", out));
         };
         // Frames carry the scene's step: a run from a state file at step S writes S, S + every, ...
         frame(state.step);
-        try {
-            driver.run(steps, [&](std::int64_t k) { if (k % every == 0) frame(driver.current_step()); });
-        } catch (...) {
-            f.close();
-            fs::remove(tmp);
-            throw;
-        }
-        f.flush();
-        if (!f) {
-            fs::remove(tmp);
-            throw Error(fmt::format("{}: write failed", tmp.string()));
-        }
-    }
-    fs::rename(tmp, target);
+        driver.run(steps, [&](std::int64_t k) { if (k % every == 0) frame(driver.current_step()); });
+    });
     return 0;
 }
 

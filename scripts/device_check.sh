@@ -6,16 +6,22 @@
 #   scripts/device_check.sh             on the GPU machine, from the repository root, with build-gpu/dist/
 #                                       carried there: provenance, the bitwise comparisons, the benchmark
 #
-# The run writes results/gpu/ (and archives it under $OUT when $OUT is set): nvidia-smi, the code the
-# binary carries, `demmat compare` of cuda against arrays (dense bed and compression stage, 1000 steps),
-# and `demmat bench` of cuda beside fast at 16 threads and at 1 on dense beds of 10^4, 10^5 and 10^6
-# grains settled on the device, and on the loose lattice of 10^7. It keeps to a time budget (BUDGET_S,
-# default 450 s): a stage that no longer fits is skipped and says so in results/gpu/log.txt.
+# The run replaces results/gpu/ (and archives it under $OUT when $OUT is set): nvidia-smi, the code the
+# binary carries, `demmat compare` of cuda against arrays under every law (dense bed settling and its
+# compression stage, 1000 steps each), and `demmat bench` of cuda beside fast at every core and at 1
+# under the paper's law, mindlin and mindlin + sds on dense beds of 10^6, 10^4 and 10^5 grains settled
+# on the device under each law, and where BIG is set the paper's law on a loose lattice of BIG grains.
+# It keeps to a time budget (BUDGET_S, default 450 s): a stage that no longer fits is skipped and says
+# so in results/gpu/log.txt. runs.tsv names each result file's law, for analysis/summarise_gpu.py.
 # Knobs: BUDGET_S, SETTLE_TIME (simulated seconds of settling, default 0.15: the 12-layer bed has
-# collapsed by then), SIZES (default "10000 100000 1000000"), BIG (default 10000000; 0 skips it),
-# CMP_N and CMP_STEPS (the comparisons' bed and length, default 2000 and 1000), CHECK_EVERY (steps
-# between the health checks of a settle, default 1500), RESULTS (default results/gpu).
-# VARIANT=cuda_host runs the whole flow on the CPU, to try the script without a GPU.
+# collapsed by then), SIZES (default "1000000 10000 100000"), BIG (default 0: none; 10000000 was run
+# before the laws),
+# LAWS (compared, default "paper tsuji linear_history mindlin mindlin_sds"), BENCH_LAWS (benchmarked,
+# default "paper mindlin mindlin_sds"), CMP_N and CMP_STEPS (the comparisons' bed and length, default
+# 2000 and 1000), CHECK_EVERY (steps between the health checks of a settle, default 3000), THREADS (fast's
+# threads beside 1, default every core), RESULTS (default results/gpu).
+# VARIANT=cuda_host runs the whole flow on the CPU, to try the script without a GPU (with RESULTS set to
+# a scratch folder, and small SIZES, BIG=0, CMP_N and CMP_STEPS).
 # Usage: scripts/device_check.sh [--pack [--fast-arch ARCH]] [--build-dir DIR]
 #   --pack            on the build machine: build DIR and pack DIR/dist for the GPU machine
 #   --fast-arch ARCH  with --pack: compile fast for the GPU machine's CPU (GCC's -march=ARCH, e.g.
@@ -89,14 +95,20 @@ fi
 # ---- on the GPU machine --------------------------------------------------------------------------------
 budget=${BUDGET_S:-450}
 settle_time=${SETTLE_TIME:-0.15}
-sizes=${SIZES:-"10000 100000 1000000"}
-big=${BIG:-10000000}
+sizes=${SIZES:-"1000000 10000 100000"}  # the target's size first: a budget cut falls on the others
+big=${BIG:-0}
+laws=${LAWS:-"paper tsuji linear_history mindlin mindlin_sds"}
+bench_laws=${BENCH_LAWS:-"paper mindlin mindlin_sds"}
+threads=${THREADS:-$(nproc)}
+for law in $laws $bench_laws; do contact_args "$law" > /dev/null || exit 2; done
 start=$SECONDS
 res=${RESULTS:-results/gpu}
 gpu=${VARIANT:-cuda}
 work=$res/work
-mkdir -p "$res" "$work"
+rm -rf "$res" && mkdir -p "$res" "$work"  # this run's files only (the folder holds the committed run's)
 log=$res/log.txt
+runs=$res/runs.tsv
+printf 'file\tlaw\n' > "$runs"
 : > "$log"
 say() { echo "$*" | tee -a "$log"; }
 left() { echo $((budget - (SECONDS - start))); }
@@ -145,49 +157,63 @@ fi
 "${demmat[@]}" list | tee "$res/list.txt" | tee -a "$log"
 if ! grep -E "^$gpu " "$res/list.txt" | grep -qv unavailable; then say "error: the $gpu variant cannot run here (see list.txt)"; exit 1; fi
 
-# A settle on the device checks its health every CHECK_EVERY steps (default 1500), not the scene's 100:
+# A settle on the device checks its health every CHECK_EVERY steps (default 3000), not the scene's 100:
 # each check reads the whole state back and finds its contacts on one CPU core, which at 10^6 grains
 # would take longer than the steps between the checks.
-check_every=${CHECK_EVERY:-1500}
-device_scene() {  # device_scene N FILE: the dense bed of N grains, checked every check_every steps
-  "${demmat[@]}" scene dense-bed --n "$1" -o "$2" && sed -i "s/^interval = .*/interval = $check_every/" "$2"
+check_every=${CHECK_EVERY:-3000}
+device_scene() {  # device_scene N FILE [ARGS]: the dense bed of N grains, checked every check_every steps
+  local n=$1 f=$2; shift 2
+  "${demmat[@]}" scene dense-bed --n "$n" "$@" -o "$f" && sed -i "s/^interval = .*/interval = $check_every/" "$f"
 }
 
 cmp_steps=${CMP_STEPS:-1000}
-say "== bitwise: $gpu against arrays (and a second $gpu run), $cmp_steps steps"
+say "== bitwise: $gpu against arrays (and a second $gpu run), $cmp_steps steps, under each law: $laws"
 n=${CMP_N:-2000}
-device_scene "$n" "$work/bed_$n.toml"
-run_capped 120 "${demmat[@]}" run "$work/bed_$n.toml" --variant "$gpu" --time "$settle_time" --save "$work/bed_${n}_settled.state" -q \
-  --json "$res/settle_$n.json" >> "$log" 2>&1
-"${demmat[@]}" scene compression --from "$work/bed_$n.toml" --state "$work/bed_${n}_settled.state" -o "$work/bed_${n}_compression.toml"
 cmp_failed=0  # a difference (or a failed compare) makes the whole check fail, after the benchmarks
-for s in "bed_$n" "bed_${n}_compression"; do
-  run_capped 90 "${demmat[@]}" compare "$work/$s.toml" --variants "$gpu,arrays,$gpu" --steps "$cmp_steps" 2>&1 | tee -a "$log" "$res/compare_$s.txt"
-  [[ ${PIPESTATUS[0]} == 0 ]] || cmp_failed=1
+for law in $laws; do
+  # shellcheck disable=SC2046  # contact_args is a list of words on purpose
+  set -- $(contact_args "$law")
+  b=bed_${n}_$law
+  device_scene "$n" "$work/$b.toml" "$@"
+  # Settled on the device under the law: the compression stage starts from its state, stretches and all.
+  run_capped 120 "${demmat[@]}" run "$work/$b.toml" --variant "$gpu" --time "$settle_time" --save "$work/${b}_settled.state" -q \
+    --json "$res/settle_$b.json" >> "$log" 2>&1
+  "${demmat[@]}" scene compression --from "$work/$b.toml" --state "$work/${b}_settled.state" "$@" -o "$work/${b}_compression.toml"
+  for s in "$b" "${b}_compression"; do
+    run_capped 90 "${demmat[@]}" compare "$work/$s.toml" --variants "$gpu,arrays,$gpu" --steps "$cmp_steps" 2>&1 | tee -a "$log" "$res/compare_$s.txt"
+    [[ ${PIPESTATUS[0]} == 0 ]] || cmp_failed=1
+    printf 'compare_%s.txt\t%s\n' "$s" "$law" >> "$runs"
+  done
 done
 
-say "== benchmark: us per particle-step, $gpu beside fast at 16 threads and at 1"
-# bench LABEL SCENE STEPS REPS CAP: each configuration alone (its own JSON), so that one cut off loses only itself.
+say "== benchmark: us per particle-step, $gpu beside fast at $threads threads and at 1, under: $bench_laws"
+# bench LABEL LAW SCENE STEPS REPS CAP: each configuration alone (its own JSON), so that one cut off loses only itself.
 bench() {
-  for cfg in "$gpu:1" fast:16 fast:1; do
-    local v=${cfg%:*} t=${cfg#*:} f="$res/bench_$1_${cfg/:/_}" k=$3
+  for cfg in "$gpu:1" "fast:$threads" fast:1; do
+    local v=${cfg%:*} t=${cfg#*:} f="bench_$1_$2_${cfg/:/_}" k=$4
     [[ $v == "$gpu" ]] && k=$((k * 10 > 200 ? 200 : k * 10))  # the device's steps are short: more of them
-    run_capped "$5" "${demmat[@]}" bench "$2" --variants "$v" --threads "$t" --steps "$k" --repetitions "$4" --warmup 2 \
-      --json "$f.json" > "$f.txt" 2>> "$log"
-    tee -a "$log" < "$f.txt"
+    run_capped "$6" "${demmat[@]}" bench "$3" --variants "$v" --threads "$t" --steps "$k" --repetitions "$5" --warmup 2 \
+      --json "$res/$f.json" > "$res/$f.txt" 2>> "$log"
+    tee -a "$log" < "$res/$f.txt"
+    printf '%s.json\t%s\n' "$f" "$2" >> "$runs"
   done
 }
 for n in $sizes; do
-  device_scene "$n" "$work/bed_$n.toml"
-  run_capped 200 "${demmat[@]}" run "$work/bed_$n.toml" --variant "$gpu" --time "$settle_time" --save "$work/bed_${n}_settled.state" -q \
-    --json "$res/settle_$n.json" >> "$log" 2>&1 || continue
-  "${demmat[@]}" scene settled --from "$work/bed_$n.toml" --state "$work/bed_${n}_settled.state" -o "$work/bed_${n}_settled.toml"
   steps=$((2000000 / n)); ((steps < 3)) && steps=3; ((steps > 200)) && steps=200
-  bench "settled_$n" "$work/bed_${n}_settled.toml" "$steps" 3 150
+  for law in $bench_laws; do
+    # Settled on the device under the law itself (a state carries its law in its fingerprint).
+    b=bed_${n}_$law
+    # shellcheck disable=SC2046
+    device_scene "$n" "$work/$b.toml" $(contact_args "$law")
+    run_capped 200 "${demmat[@]}" run "$work/$b.toml" --variant "$gpu" --time "$settle_time" --save "$work/${b}_settled.state" -q \
+      --json "$res/settle_$b.json" >> "$log" 2>&1 || continue
+    "${demmat[@]}" scene settled --from "$work/$b.toml" --state "$work/${b}_settled.state" -o "$work/${b}_settled.toml"
+    bench "settled_$n" "$law" "$work/${b}_settled.toml" "$steps" 3 150
+  done
 done
 if ((big > 0)); then
   "${demmat[@]}" scene dense-bed --n "$big" -o "$work/loose_$big.toml"
-  bench "loose_$big" "$work/loose_$big.toml" 2 1 200
+  bench "loose_$big" paper "$work/loose_$big.toml" 2 1 200
 fi
 if ((cmp_failed)); then
   say "error: $gpu is not bit-identical to arrays on every comparison (results: compare_*.txt)"

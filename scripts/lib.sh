@@ -18,6 +18,7 @@
 #                                 configure DIR (Release unless a CMAKE_BUILD_TYPE is given) and build
 #                                 only TARGETs (everything without any); -q: no build log on stdout
 #   demmat_in DIR                 the absolute path of DIR's demmat program (still right after a cd)
+#   contact_args LAW              the `--contact KEY=VALUE` words of a named law (paper: none)
 set -euo pipefail
 SCRIPT=$(basename "$0")
 script_file=$(cd "$(dirname "$0")" && pwd)/$SCRIPT   # for usage, after the cd below
@@ -84,4 +85,18 @@ cmake_build() {
 
 demmat_in() {
   if [[ $1 == /* ]]; then echo "$1/app/demmat"; else echo "$PWD/$1/app/demmat"; fi
+}
+
+# contact_args LAW: the scene options of the laws the scripts run, with the parameters of
+# tests/test_memory_equivalence.cpp (paper, tsuji, linear_history, mindlin, mindlin_sds).
+contact_args() {
+  case "$1" in
+    paper) ;;
+    tsuji) echo "--contact damping=tsuji --contact restitution=0.6" ;;
+    linear_history) echo "--contact tangential=linear_history --contact kt=100 --contact tangential_damping_ratio=0.5" ;;
+    mindlin) echo "--contact tangential=mindlin --contact tangential_damping_ratio=0.5" ;;
+    mindlin_sds) echo "--contact tangential=mindlin --contact tangential_damping_ratio=0.5 --contact rolling=sds" \
+                      "--contact kr=50 --contact rolling_damping=0.05 --contact rolling_friction=0.2" ;;
+    *) echo "$SCRIPT: unknown law '$1' (paper, tsuji, linear_history, mindlin, mindlin_sds)" >&2; return 2 ;;
+  esac
 }

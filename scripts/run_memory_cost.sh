@@ -37,17 +37,8 @@ if ! [[ $settle =~ ^[0-9]*\.?[0-9]+$ ]] || ! awk -v t="$settle" 'BEGIN { exit !(
 fi
 [[ $threads =~ ^[0-9]+(,[0-9]+)*$ ]] || { echo "$SCRIPT: --threads must be thread counts such as 1 or 1,2, not '$threads'" >&2; exit 2; }
 
-# The laws (their [contact] keys; the parameters of tests/test_memory_equivalence.cpp).
+# The laws (their [contact] keys: contact_args, lib.sh).
 laws=(paper linear_history mindlin mindlin_sds)
-contact_args() {
-  case "$1" in
-    paper) ;;
-    linear_history) echo "--contact tangential=linear_history --contact kt=100 --contact tangential_damping_ratio=0.5" ;;
-    mindlin) echo "--contact tangential=mindlin --contact tangential_damping_ratio=0.5" ;;
-    mindlin_sds) echo "--contact tangential=mindlin --contact tangential_damping_ratio=0.5 --contact rolling=sds" \
-                      "--contact kr=50 --contact rolling_damping=0.05 --contact rolling_friction=0.2" ;;
-  esac
-}
 
 cmake_build -q "$BUILD_DIR" demmat
 demmat=$(demmat_in "$BUILD_DIR")

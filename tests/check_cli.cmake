@@ -178,3 +178,26 @@ string(REGEX MATCH "ITEM: TIMESTEP\n[0-9]+" first "${dump}")
 if(NOT first STREQUAL "ITEM: TIMESTEP\n54")
   message(FATAL_ERROR "import-lammps of a dump whose last frame is step 54, dumped again: first frame ${first}")
 endif()
+
+# A continued scene: the state's particle count must be the --from scene's, the walls it writes are
+# where the state has them, and a run whose scene moves a wall the state knows says it is not applied.
+run_ok(scene drop -o ${WORK}/drop.toml)
+execute_process(COMMAND ${DEMMAT} scene compression --from ${WORK}/drop.toml --state ${WORK}/bed.state -o ${WORK}/wrong.toml
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(NOT rc EQUAL 2 OR NOT err MATCHES "holds 300 particles, but --from .*drop.toml makes 1" OR EXISTS ${WORK}/wrong.toml)
+  message(FATAL_ERROR "scene compression of a 300-grain state from a 1-grain scene: exit ${rc} (expected 2, nothing written): ${err}")
+endif()
+run_ok(run ${WORK}/comp.toml --steps 40 --save ${WORK}/comp.state -q)
+run_ok(scene compression --from ${WORK}/comp.toml --state ${WORK}/comp.state -o ${WORK}/comp2.toml)
+file(READ ${WORK}/comp2.toml comp2)
+expect_in("${comp2}" "name = \"x_max\"\npoint = [")  # moved by 40 steps: no longer the domain's face
+execute_process(COMMAND ${DEMMAT} run ${WORK}/comp2.toml --steps 2 -q RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+if(NOT rc EQUAL 0 OR err MATCHES "warning")
+  message(FATAL_ERROR "the compression scene written from a moved wall warns or fails (${rc}): ${err}")
+endif()
+string(REPLACE "face = \"z_min\"" "name = \"z_min\"\npoint = [0, 0, 0.001]\nnormal = [0, 0, 1]" edited "${settled_text}")
+file(WRITE ${WORK}/edited.toml "${edited}")
+execute_process(COMMAND ${DEMMAT} run ${WORK}/edited.toml --steps 2 -q RESULT_VARIABLE rc ERROR_VARIABLE err OUTPUT_QUIET)
+if(NOT rc EQUAL 0 OR NOT err MATCHES "warning: wall 'z_min' of the scene .* is not where the state file has it")
+  message(FATAL_ERROR "a continued scene whose z_min was edited: exit ${rc}, expected 0 and a warning: ${err}")
+endif()

@@ -129,39 +129,50 @@ class Loader(unittest.TestCase):
         self.assertEqual(row[0].split("|")[4].strip(), f"{us['fast'] / us['fast_unordered']:.3f}")
 
     def test_summarise_gpu_speed_up_over_cuda_and_the_verdicts(self):
-        # the sample's arrays as cuda and its fast as fast at 2 threads, each in its own file as
-        # device_check.sh writes them: fast's row carries its median over cuda's, and each compare's
-        # last line is quoted, a difference as well as an identity
+        # the sample's arrays as cuda and its fast as fast at 2 threads under the paper's law, and its
+        # fast as cuda under mindlin, each in its own file as device_check.sh writes them, the laws named
+        # by runs.tsv: fast's row carries its median over cuda's of the same law, cuda under mindlin its
+        # median over cuda's under the paper's law; each compare's last line is quoted under its law and
+        # stage, a difference as well as an identity
         import json
         raw = json.load(open(os.path.join(DATA, "bench_sample.json")))
         work = tempfile.mkdtemp()
         try:
             us = {}
-            for v, name in (("arrays", "cuda"), ("fast", "fast")):
+            runs = ["file\tlaw"]
+            for v, name, law in (("arrays", "cuda", "paper"), ("fast", "fast", "paper"), ("fast", "cuda", "mindlin")):
                 one = json.loads(json.dumps(raw))
                 one["samples"] = [dict(x, variant=name) for x in one["samples"] if x["variant"] == v]
                 one["summary"] = [dict(x, variant=name) for x in one["summary"] if x["variant"] == v]
-                us[name] = one["summary"][0]["us_per_particle_step"]
-                threads = one["summary"][0]["threads"]
-                with open(os.path.join(work, f"bench_settled_2000_{name}_{threads}.json"), "w") as f:
+                if name == "cuda":  # one thread, as the device runs
+                    one["summary"] = [dict(x, threads=1, threads_asked=1) for x in one["summary"]]
+                us[name, law] = one["summary"][0]["us_per_particle_step"]
+                file = f"bench_settled_2000_{law}_{name}_{one['summary'][0]['threads']}.json"
+                runs.append(f"{file}\t{law}")
+                with open(os.path.join(work, file), "w") as f:
                     json.dump(one, f)
-            with open(os.path.join(work, "compare_bed_2000.txt"), "w") as f:
+            with open(os.path.join(work, "compare_bed_2000_paper.txt"), "w") as f:
                 f.write("identical: cuda, arrays, cuda over 1000 steps of 'dense_bed_2000' (2000 particles)\n")
-            with open(os.path.join(work, "compare_bed_2000_compression.txt"), "w") as f:
+            with open(os.path.join(work, "compare_bed_2000_mindlin_compression.txt"), "w") as f:
                 f.write("step 1\nfirst difference: step 3, particle 7, position x\n")
+            runs += ["compare_bed_2000_paper.txt\tpaper", "compare_bed_2000_mindlin_compression.txt\tmindlin"]
+            with open(os.path.join(work, "runs.tsv"), "w") as f:
+                f.write("\n".join(runs) + "\n")
             out = os.path.join(work, "summary.md")
             subprocess.run([sys.executable, os.path.join(ANALYSIS, "summarise_gpu.py"), work, "-o", out], check=True,
                            stdout=subprocess.DEVNULL)
             text = open(out).read()
         finally:
             shutil.rmtree(work)
-        self.assertIn("- bed_2000: identical: cuda, arrays, cuda over 1000 steps", text)
-        self.assertIn("- bed_2000_compression: first difference: step 3, particle 7, position x", text)
-        rows = {line.split("|")[3].strip(): line.split("|") for line in text.splitlines() if line.startswith("| settled | 2000 |")}
-        self.assertEqual(set(rows), {"cuda", "fast"})
-        self.assertEqual(rows["fast"][7].strip(), f"{us['fast'] / us['cuda']:.1f}×")
-        self.assertEqual(rows["cuda"][7].strip(), "")
-        self.assertEqual(rows["cuda"][5].strip(), f"{us['cuda']:.4f}")
+        self.assertIn("| paper's law | identical: cuda, arrays, cuda over 1000 steps of 'dense_bed_2000' (2000 particles) | (not run) |", text)
+        self.assertIn("| mindlin | (not run) | first difference: step 3, particle 7, position x |", text)
+        rows = {(c[3].strip(), c[4].strip()): c for c in (line.split("|") for line in text.splitlines() if line.startswith("| settled | 2000 |"))}
+        self.assertEqual(set(rows), {("paper's law", "cuda"), ("paper's law", "fast"), ("mindlin", "cuda")})
+        self.assertEqual(rows["paper's law", "fast"][8].strip(), f"{us['fast', 'paper'] / us['cuda', 'paper']:.1f}×")
+        self.assertEqual(rows["paper's law", "cuda"][8].strip(), "")
+        self.assertEqual(rows["paper's law", "cuda"][6].strip(), f"{us['cuda', 'paper']:.4f}")
+        self.assertEqual(rows["mindlin", "cuda"][9].strip(), f"{us['cuda', 'mindlin'] / us['cuda', 'paper']:.2f}×")
+        self.assertEqual(rows["paper's law", "cuda"][9].strip(), "")
 
     def test_google_benchmark(self):
         r = results.load(os.path.join(DATA, "gbench_sample.json"))

@@ -1,7 +1,8 @@
 // The cuda variant (docs/cuda.md). Its kernels run here on the host backend, blocks and threads in a
 // shuffled order: bit-identical to arrays at every step on a small settled bed and on its compression
-// stage (a moving wall), for two shuffles and two block sizes. On a machine with a GPU the same checks
-// run the device; elsewhere they skip, saying why. Also: the host backend's launch, and the registry's
+// stage (a moving wall), for two shuffles and two block sizes, under the paper's law and under a §9 law
+// with memory (the saved stretches bit for bit too). On a machine with a GPU the same checks run the
+// device; elsewhere they skip, saying why. Also: the host backend's launch, and the registry's
 // unavailable variants (how `cuda` shows without a GPU).
 #include <algorithm>
 #include <set>
@@ -21,8 +22,9 @@ using namespace demmat::test;
 namespace {
 
 // 400 grains settled for 15000 steps from the dense bed's loose grid (arrays), so the runs start with
-// contacts; with wall_speed > 0 the compression stage of that bed (the x_max wall moving inwards).
-Problem small_bed(double wall_speed)
+// contacts; with wall_speed > 0 the compression stage of that bed (the x_max wall moving inwards); under
+// `law` (the settled state holds no stretches: every contact's starts at zero).
+Problem small_bed(double wall_speed, const ContactModel& law = {})
 {
     static const Scene bed = dense_bed_scene(400);
     static const State settled = [] {
@@ -33,13 +35,40 @@ Problem small_bed(double wall_speed)
     }();
     State st = settled;
     Scene s = wall_speed > 0 ? compression_scene(bed, "(settled in memory)", wall_speed) : bed;
+    s.contact_model = law;
     st.walls = continue_walls(s, st);
     return Problem(s, st);
+}
+
+// Mindlin's tangential spring with sds rolling resistance, as tests/test_memory_equivalence.cpp runs it.
+ContactModel mindlin_sds()
+{
+    ContactModel m;
+    m.tangential = TangentialModel::mindlin;
+    m.tangential_damping_ratio = 0.5;
+    m.rolling = RollingModel::sds;
+    m.kr = 50.0;
+    m.rolling_damping = 0.05;
+    m.rolling_friction = 0.2;
+    return m;
+}
+
+// "" when two states hold the same contacts with the same stretches, bit for bit and in the same order.
+std::string stretch_difference(const State& a, const State& b)
+{
+    if (a.stretches.size() != b.stretches.size()) return fmt::format("{} stretches against {}", b.stretches.size(), a.stretches.size());
+    for (std::size_t k = 0; k < a.stretches.size(); ++k) {
+        const ContactStretch &x = a.stretches[k], &y = b.stretches[k];
+        if (x.i != y.i || x.partner != y.partner || x.wall != y.wall || !(x.tangential == y.tangential) || !(x.rolling == y.rolling))
+            return fmt::format("stretch {} ({}, {}{}) differs", k, x.i, x.wall ? "wall " : "", x.partner);
+    }
+    return "";
 }
 
 struct Lockstep {
     std::string difference;  // "" when every run matched arrays at every step, and in the saved state
     ContactCounts counts;    // arrays' at the end
+    State saved;             // arrays' saved state at the end
 };
 
 // arrays and the given variants in lockstep, compared bit for bit after every step (snapshot and
@@ -75,8 +104,11 @@ Lockstep lockstep(const Setup& setup, std::int64_t steps, std::vector<std::uniqu
         if (!(sa.trans.x == sb.trans.x && sa.trans.b5 == sb.trans.b5 && sa.rot.v == sb.rot.v && sa.rot.b5 == sb.rot.b5 &&
               sa.radius == sb.radius && sa.step == sb.step && sa.walls.size() == sb.walls.size()))
             out.difference = fmt::format("run {}: the saved state differs", v);
+        else if (const std::string d = stretch_difference(sa, sb); !d.empty())
+            out.difference = fmt::format("run {}: the saved stretches differ: {}", v, d);
     }
     out.counts = ref->counts();
+    out.saved = sa;
     return out;
 }
 
@@ -140,6 +172,38 @@ TEST(CudaHost, CompressionStageIsBitIdenticalToArraysAtEveryStepForTwoShuffles)
     const Lockstep r = lockstep(c.setup(), 300, two_shuffles());
     EXPECT_EQ(r.difference, "");
     EXPECT_GT(r.counts.particle_particle, 400);
+}
+
+TEST(CudaHost, LawWithMemoryIsBitIdenticalToArraysAtEveryStepForTwoShuffles)
+{
+    // Each pair's stretches are kept in both of its particles' rows and advanced by both threads; the
+    // rows follow the particles through the re-sort of every search. Settling and compressed, the saved
+    // stretches arrays' bit for bit, and many of them nonzero (the memory was exercised).
+    for (double wall_speed : {0.0, 0.5}) {
+        Problem c = small_bed(wall_speed, mindlin_sds());
+        const Lockstep r = lockstep(c.setup(), 300, two_shuffles());
+        EXPECT_EQ(r.difference, "") << "wall speed " << wall_speed;
+        std::size_t pairs = 0, walls = 0;
+        for (const ContactStretch& k : r.saved.stretches)
+            if (!(k.tangential == Vec3d{}) && !(k.rolling == Vec3d{})) ++(k.wall ? walls : pairs);
+        EXPECT_GT(pairs, 300u);
+        EXPECT_GT(walls, 20u);
+    }
+}
+
+TEST(CudaHost, ContinuesFromASavedStateWithStretchesAsArraysDoes)
+{
+    // Saved by cuda_host mid-run (state format v2: its stretches), then continued by cuda_host and by arrays
+    // from that state: both continuations the same at every step.
+    Problem c = small_bed(0.0, mindlin_sds());
+    auto v = make_cuda_host_variant(3, 64);
+    Driver d(*v, c.setup());
+    d.run(150);
+    State mid;
+    v->save(mid);
+    ASSERT_GT(mid.stretches.size(), 300u);
+    const Problem cont(c.scene(), mid);
+    EXPECT_EQ(lockstep(cont.setup(), 150, two_shuffles()).difference, "");
 }
 
 TEST(CudaHost, AllPairsAndWideCellsGiveTheSameTrajectory)
@@ -206,4 +270,13 @@ TEST(CudaDevice, CompressionStageIsBitIdenticalToArraysAtEveryStep)
     if (const std::string why = device_missing(); !why.empty()) GTEST_SKIP() << "cuda: " << why;
     Problem c = small_bed(0.5);
     EXPECT_EQ(lockstep(c.setup(), 300, device_run()).difference, "");
+}
+
+TEST(CudaDevice, LawWithMemoryIsBitIdenticalToArraysAtEveryStep)
+{
+    if (const std::string why = device_missing(); !why.empty()) GTEST_SKIP() << "cuda: " << why;
+    for (double wall_speed : {0.0, 0.5}) {
+        Problem c = small_bed(wall_speed, mindlin_sds());
+        EXPECT_EQ(lockstep(c.setup(), 300, device_run()).difference, "") << "wall speed " << wall_speed;
+    }
 }

@@ -113,7 +113,7 @@ TEST(SceneFile, BadScenesGiveOneLineErrors)
         {with("dt = 1e-5", "dt = \"fast\""), "must be a number"},
         {with("dt = 1e-5", "dt = 1e-5\ngravity = [0, 0, nan]"), "must be finite"},
         {with("max = [0.1, 0.1, 0.1]", "max = [0.1, 0.1"), "TOML syntax error"},
-        {with("face = \"z_min\"", "face = \"floor\""), "unknown box face"},
+        {with("face = \"z_min\"", "face = \"floor\""), "'wall[0].face': unknown box face 'floor'"},
         {std::string(kGood) + "[search]\nmethod = \"octree\"\n", "unknown search method 'octree'"},
         {std::string(kGood) + "[[particles.particle]]\nradius = 0.004\nposition = [0.053, 0.05, 0.05]\n", "particles 0 and 1 overlap"},
     };
@@ -121,6 +121,23 @@ TEST(SceneFile, BadScenesGiveOneLineErrors)
         const std::string e = error_of(toml);
         EXPECT_NE(e.find(expect), std::string::npos) << "expected '" << expect << "', got '" << e << "'";
         EXPECT_EQ(e.find('\n'), std::string::npos) << "not one line: " << e;
+    }
+}
+
+TEST(SceneFile, AWallNormalOfHugeOrTinyComponentsIsNormalised)
+{
+    // n·n of (1e300, 1e300, 0) overflows and of (1e-320, 0, 0) underflows: the normal must still be a unit
+    // vector (it was (0, 0, 0), and the scene was refused as a particle overlapping the wall).
+    const std::pair<std::string, Vec3d> cases[] = {{"[1e300, 1e300, 0]", {std::sqrt(0.5), std::sqrt(0.5), 0.0}},
+                                                    {"[1e-320, 0, 0]", {1.0, 0.0, 0.0}},
+                                                    {"[0, -3e-200, 4e-200]", {0.0, -0.6, 0.8}}};
+    for (const auto& [normal, unit] : cases) {
+        const std::string text = "[time]\ndt = 1e-5\n[domain]\nmin = [0, 0, 0]\nmax = [1, 1, 1]\n[[wall]]\npoint = [0, 0, 0]\nnormal = " +
+                                 normal + "\n[particles]\nsource = \"state\"\nfile = \"x.state\"\n";
+        const Vec3d n = parse_scene(text, "normal").walls.at(0).normal;
+        EXPECT_NEAR(n.x, unit.x, 1e-15) << normal;
+        EXPECT_NEAR(n.y, unit.y, 1e-15) << normal;
+        EXPECT_NEAR(n.z, unit.z, 1e-15) << normal;
     }
 }
 

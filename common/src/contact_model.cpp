@@ -1,6 +1,8 @@
 // The scene's [contact] table (docs/scene-format.md): which law of physics.md §9 a run uses.
 #include "contact_model_toml.hpp"
+#include "toml_numbers.hpp"
 
+#include <cerrno>
 #include <cmath>
 #include <cstdlib>
 #include <set>
@@ -66,12 +68,9 @@ public:
         if (!has(key)) fail(fmt::format("missing key 'contact.{}' (needed by {})", key, needed_by));
         used_.insert(key);
         const auto& x = v_.as_table().at(key);
-        double d = 0.0;
-        if (x.is_floating()) d = x.as_floating();
-        else if (x.is_integer()) d = double(x.as_integer());
-        else fail(fmt::format("'contact.{}' must be a number", key));
-        if (!std::isfinite(d)) fail(fmt::format("'contact.{}' must be finite (got {})", key, d));
-        return d;
+        if (!x.is_floating() && !x.is_integer()) fail(fmt::format("'contact.{}' must be a number", key));
+        if (const std::string problem = toml_number_problem(x, "contact." + key); !problem.empty()) fail(problem);
+        return x.is_floating() ? x.as_floating() : double(x.as_integer());
     }
     double positive(const std::string& key, const std::string& needed_by)
     {
@@ -190,8 +189,12 @@ ContactModel contact_model_from_options(const std::vector<std::string>& key_valu
         for (char c : key)
             if (!(std::isalnum(static_cast<unsigned char>(c)) || c == '_')) throw Error(fmt::format("--contact '{}': not a key", kv));
         char* end = nullptr;
-        std::strtod(value.c_str(), &end);
+        errno = 0;
+        const double parsed = std::strtod(value.c_str(), &end);
         const bool number = !value.empty() && *end == '\0';
+        // toml11 would read 1e400 as the largest double and 1e-400 as 0 without a word.
+        if (number && errno == ERANGE && (std::abs(parsed) > 1.0 || parsed == 0.0))
+            throw Error(fmt::format("--contact {}: {} is beyond the range of a double", kv, value));
         std::string quoted = "\"";
         for (char c : value) {
             if (static_cast<unsigned char>(c) < 0x20) throw Error(fmt::format("--contact '{}': control character in the value", key));

@@ -91,13 +91,14 @@ Driver::Driver(Variant& variant, const Setup& setup) : variant_(variant), setup_
 {
     // The one place that refuses an integrator or precision a variant would otherwise silently ignore.
     const IntegratorChoice& choice = setup.scene->integrator;
+    const std::string who = variant_.registered_name().empty() ? "this variant" : fmt::format("variant '{}'", variant_.registered_name());
     if (!variant_.supports(choice))
-        throw Error(fmt::format("this variant integrates with gear5 in double only, not {} (the arrays variant runs "
-                                "every integrator and precision)", choice.describe()));
+        throw Error(fmt::format("{} integrates with gear5 in double only, not {} (the arrays variant runs every integrator and precision)",
+                                who, choice.describe()));
     const ContactModel& law = setup.scene->contact_model;
     if (!variant_.supports(law))
         throw Error(fmt::format("{} computes the paper's contact law only, not {} (the arrays variant runs the laws of physics.md §9)",
-                                variant_.registered_name().empty() ? "this variant" : fmt::format("variant '{}'", variant_.registered_name()),
+                                who,
                                 law.describe()));
     variant_.init(setup_);
     const Scene& scene = *setup.scene;

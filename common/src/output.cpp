@@ -1,6 +1,7 @@
 #include "demmat/output.hpp"
 
 #include <algorithm>
+#include <charconv>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -8,6 +9,7 @@
 
 #include <fmt/format.h>
 
+#include "demmat/error.hpp"
 #include "demmat/io.hpp"
 #include "demmat/provenance.hpp"
 
@@ -100,6 +102,49 @@ void VtkSeries::write_walls(const std::string& file, std::int64_t step) const
         vector_array(o, "velocity", velocity);
         o << "      </CellData>\n    </Piece>\n  </PolyData>\n</VTKFile>\n";
     });
+}
+
+std::int64_t vtk_snapshot_step(const std::string& name, const std::string& stem)
+{
+    const std::string ext = ".vtp";
+    if (name.size() <= stem.size() + 1 + ext.size() || name.compare(0, stem.size() + 1, stem + "_") != 0 ||
+        name.compare(name.size() - ext.size(), ext.size(), ext) != 0)
+        return -1;
+    std::string digits = name.substr(stem.size() + 1, name.size() - stem.size() - 1 - ext.size());
+    if (digits.rfind("walls_", 0) == 0) digits.erase(0, 6);
+    std::int64_t step = -1;
+    const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), step);
+    // At least 9 digits, as write() pads them; a 10-digit step has no padding.
+    if (ec != std::errc() || end != digits.data() + digits.size() || digits.size() < 9 || digits[0] == '-') return -1;
+    return fmt::format("{:09d}", step) == digits ? step : -1;
+}
+
+void check_vtk_names(const std::filesystem::path& dir, const std::string& stem, std::int64_t first, std::int64_t last,
+                     const std::vector<std::pair<std::filesystem::path, std::string>>& others)
+{
+    namespace fs = std::filesystem;
+    auto in_run = [&](const fs::path& p) {
+        const std::int64_t k = vtk_snapshot_step(p.filename().string(), stem);
+        return k >= first && k <= last ? k : -1;
+    };
+    for (const auto& [path, what] : others) {
+        if (path.empty()) continue;
+        const fs::path folder = path.has_parent_path() ? path.parent_path() : fs::path(".");
+        const std::int64_t k = in_run(path);
+        if (k >= 0 && same_file(folder, dir))
+            throw Error(fmt::format("--vtk {}: the snapshot of step {} would be {} {}; refusing to overwrite it", dir.string(), k, what,
+                                    path.string()));
+    }
+    std::error_code ec;
+    for (fs::directory_iterator it(dir, ec), end; !ec && it != end; it.increment(ec)) {
+        const std::int64_t k = in_run(it->path());
+        if (k < 0) continue;
+        std::error_code sc;
+        const fs::file_status st = it->symlink_status(sc);
+        if (!sc && st.type() != fs::file_type::regular && st.type() != fs::file_type::symlink)
+            throw Error(fmt::format("--vtk {}: {}, where the snapshot of step {} goes, is not a regular file", dir.string(),
+                                    it->path().filename().string(), k));
+    }
 }
 
 std::vector<Vec3d> plane_in_box(const Vec3d& point, const Vec3d& normal, const Box& box)

@@ -5,7 +5,6 @@
 #include <cmath>
 #include <fstream>
 #include <map>
-#include <regex>
 #include <sstream>
 
 #include <fmt/format.h>
@@ -23,6 +22,9 @@ namespace {
 std::string d17(double v) { return fmt::format("{:.17g}", v); }
 
 const char* kAxis[3] = {"x", "y", "z"};
+
+// The most particles a state holds: the variants index them with 32-bit integers (as the scene reader bounds a grid).
+constexpr std::int64_t kMaxParticles = 2147483647;
 
 // The axis a unit normal lies along, or -1.
 int axis_of(const Vec3d& n)
@@ -366,6 +368,20 @@ State import_peer_state(const std::filesystem::path& file, const Scene& scene)
         return v;
     };
 
+    // An atom count as written (an integer, no exponent), believed only as far as the file can hold it:
+    // each atom needs a line of its own after line k, so a header cannot make the reader allocate more.
+    auto atom_count = [&](const std::string& text, std::size_t k) {
+        std::int64_t c = 0;
+        const auto [end, ec] = std::from_chars(text.data(), text.data() + text.size(), c);
+        if (ec == std::errc::result_out_of_range || (ec == std::errc() && end == text.data() + text.size() && c > kMaxParticles))
+            bad(label, k + 1, fmt::format("{} atoms is more than the {} particles a state can hold", text, kMaxParticles));
+        if (ec != std::errc() || end != text.data() + text.size() || c < 1) bad(label, k + 1, fmt::format("bad number of atoms '{}'", text));
+        if (std::uint64_t(c) > lines.size() - k - 1)
+            bad(label, k + 1, fmt::format("the header announces {} atoms, but only {} lines follow it", c, lines.size() - k - 1));
+        return std::size_t(c);
+    };
+    auto is_section = [&](const std::string& t) { return t == "Atoms" || t == "Velocities"; };
+
     std::size_t n = 0;
     std::vector<double> radius, density;
     std::vector<Vec3d> x, v, w;
@@ -401,9 +417,8 @@ State import_peer_state(const std::filesystem::path& file, const Scene& scene)
             step = step_of(lines[k + 1], k + 1);
             k += 2;
             if (k >= lines.size() || trim(lines[k]) != "ITEM: NUMBER OF ATOMS") bad(label, k + 1, "expected ITEM: NUMBER OF ATOMS");
-            const double count = numbers(k + 1, 1)[0];
-            if (count < 1 || count != std::floor(count)) bad(label, k + 2, "bad number of atoms");
-            n = std::size_t(count);
+            if (k + 1 >= lines.size()) bad(label, k + 1, "the dump frame is truncated");
+            n = atom_count(trim(lines[k + 1]), k + 1);
             k += 2;
             if (k >= lines.size() || lines[k].rfind("ITEM: BOX BOUNDS", 0) != 0) bad(label, k + 1, "expected ITEM: BOX BOUNDS");
             k += 4;
@@ -423,6 +438,8 @@ State import_peer_state(const std::filesystem::path& file, const Scene& scene)
                 const std::size_t line = k + 1 + a;
                 if (line >= lines.size()) bad(label, line, "the dump frame is truncated");
                 const std::vector<double> row = numbers(line, col.size());
+                if (row.size() != col.size())
+                    bad(label, line + 1, fmt::format("{} values, but ITEM: ATOMS names {} columns", row.size(), col.size()));
                 const std::size_t i = slot(row[col["id"]], line);
                 if (seen[i]) bad(label, line + 1, fmt::format("atom id {} appears twice", i + 1));
                 seen[i] = 1;
@@ -436,21 +453,22 @@ State import_peer_state(const std::filesystem::path& file, const Scene& scene)
         }
         if (!any) bad(label, 1, "the dump has no frame");
     } else {
-        static const std::regex title(R"(^LAMMPS data file from demmat export-lammps: .* at step ([0-9]+), [0-9]+ particles,)");
-        std::smatch m;
-        if (!lines.empty() && std::regex_search(lines[0], m, title)) step = step_of(m[1].str(), 0);
+        // export-lammps's title: "LAMMPS data file from demmat export-lammps: scene '…' at step S, N particles, …".
+        const std::string head = "LAMMPS data file from demmat export-lammps: ";
+        if (!lines.empty() && lines[0].rfind(head, 0) == 0) {
+            const std::string& t = lines[0];
+            const auto at = t.rfind(" at step ", t.find(" particles,"));
+            const auto comma = at == std::string::npos ? std::string::npos : t.find(", ", at);
+            if (comma != std::string::npos) step = step_of(t.substr(at + 9, comma - at - 9), 0);
+        }
         std::size_t k = 1;  // line 1 is the title
         for (; k < lines.size(); ++k) {
             const std::string t = trim(lines[k]);
             if (t.empty()) continue;
             if (t == "Atoms" || t == "Velocities") break;
             std::istringstream ss(t);
-            double value;
-            std::string word;
-            if (ss >> value >> word && word == "atoms") {
-                if (value < 1 || value != std::floor(value)) bad(label, k + 1, "bad number of atoms");
-                n = std::size_t(value);
-            }
+            std::string value, word;
+            if (ss >> value >> word && word == "atoms" && !(ss >> word)) n = atom_count(value, k);
         }
         if (n == 0) bad(label, k, "no 'N atoms' line in the header of this LAMMPS data file");
         allocate();
@@ -458,11 +476,16 @@ State import_peer_state(const std::filesystem::path& file, const Scene& scene)
         while (k < lines.size()) {
             const std::string section = trim(lines[k]);
             if (section.empty()) { ++k; continue; }
-            if (section != "Atoms" && section != "Velocities") bad(label, k + 1, fmt::format("unknown section '{}' (expected Atoms or Velocities)", section));
+            if (!is_section(section)) {
+                if (std::isdigit(static_cast<unsigned char>(section[0])))
+                    bad(label, k + 1, fmt::format("more atom lines than the {} atoms the header announces", n));
+                bad(label, k + 1, fmt::format("unknown section '{}' (expected Atoms or Velocities)", section));
+            }
             ++k;
             std::size_t got = 0;
             while (k < lines.size() && got < n) {
                 if (trim(lines[k]).empty()) { ++k; continue; }
+                if (is_section(trim(lines[k]))) break;  // the next section: this one is short (reported below)
                 const std::vector<double> row = numbers(k, 7);
                 const std::size_t i = slot(row[0], k);
                 if (section == "Atoms") {
@@ -492,6 +515,10 @@ State import_peer_state(const std::filesystem::path& file, const Scene& scene)
                                         label, i + 1, x[i].x, x[i].y, x[i].z, scene.name, scene.domain.min.x, scene.domain.min.y,
                                         scene.domain.min.z, scene.domain.max.x, scene.domain.max.y, scene.domain.max.z));
         if (!(radius[i] > 0.0) || !std::isfinite(radius[i])) throw Error(fmt::format("{}: atom id {} has radius {}", label, i + 1, radius[i]));
+        const Vec3d side = scene.domain.max - scene.domain.min;
+        if (2.0 * radius[i] > std::min({side.x, side.y, side.z}))
+            throw Error(fmt::format("{}: atom id {} has diameter {} m, larger than the smallest side {} m of the domain of scene '{}'",
+                                    label, i + 1, 2.0 * radius[i], std::min({side.x, side.y, side.z}), scene.name));
         if (std::abs(density[i] - scene.material.density) > 1e-12 * scene.material.density)
             throw Error(fmt::format("{}: atom id {} has density {}, the scene's material has {}", label, i + 1, density[i], scene.material.density));
         for (const Vec3d* q : {&x[i], &v[i], &w[i]})

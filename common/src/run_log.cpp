@@ -6,6 +6,8 @@
 #include <cstring>
 
 #include <fcntl.h>
+#include <sys/file.h>
+#include <sys/stat.h>
 #include <fmt/format.h>
 #include <unistd.h>
 
@@ -88,6 +90,8 @@ std::string log_line(const LogRow& r)
 void check_log_path(const std::filesystem::path& log, const std::vector<std::filesystem::path>& inputs)
 {
     namespace fs = std::filesystem;
+    if (log.empty()) throw Error("--log: an empty file name");
+    if (log == kStandardOutput) return;
     std::error_code ec;
     if (fs::is_directory(log, ec))
         throw Error(fmt::format("--log {}: is a folder; give a file name for the run log", log.string()));
@@ -113,14 +117,31 @@ RunLog::RunLog(const std::filesystem::path& file, const Setup& setup, std::int64
     : file_(file), setup_(setup), every_(every)
 {
     check_log_every(every_);
-    fd_ = ::open(file_.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-    if (fd_ < 0) throw Error(fmt::format("{}: cannot write: {}", file_.string(), std::strerror(errno)));
+    if (file_ == kStandardOutput) {
+        fd_ = STDOUT_FILENO;
+        owned_ = false;
+    } else {
+        // Truncated only once this run holds the lock: a second run on the same log is refused, never
+        // interleaved with the first (two writers would tear each other's rows).
+        fd_ = ::open(file_.c_str(), O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
+        if (fd_ < 0) throw Error(fmt::format("{}: cannot write: {}", file_.string(), std::strerror(errno)));
+        std::string refused;
+        struct stat st {};
+        if (::flock(fd_, LOCK_EX | LOCK_NB) != 0)
+            refused = fmt::format("--log {}: another run is writing this log (it is locked); give each run its own log", file_.string());
+        else if (::fstat(fd_, &st) == 0 && S_ISREG(st.st_mode) && ::ftruncate(fd_, 0) != 0)
+            refused = fmt::format("{}: cannot write: {}", file_.string(), std::strerror(errno));
+        if (!refused.empty()) {
+            ::close(fd_);  // a throwing constructor runs no destructor
+            throw Error(refused);
+        }
+    }
     append(log_header(setup_.state->walls.size()));
 }
 
 RunLog::~RunLog()
 {
-    if (fd_ >= 0) ::close(fd_);
+    if (fd_ >= 0 && owned_) ::close(fd_);  // closing also releases the lock
 }
 
 void RunLog::write(const Snapshot& s) { append(log_line(measure_log_row(s, setup_))); }

@@ -13,8 +13,10 @@
 #include <toml.hpp>
 
 #include "contact_model_toml.hpp"
+#include "toml_numbers.hpp"
 #include "demmat/error.hpp"
 #include "demmat/io.hpp"
+#include "demmat/stability.hpp"
 
 namespace demmat {
 
@@ -65,26 +67,36 @@ public:
     double number(const std::string& key)
     {
         const auto& x = raw(key);
-        double d;
-        if (x.is_floating()) d = x.as_floating();
-        else if (x.is_integer()) d = double(x.as_integer());
-        else fail(fmt::format("'{}' must be a number", qualified(key)));
-        if (!std::isfinite(d)) fail(fmt::format("'{}' must be finite (got {})", qualified(key), d));
-        return d;
+        if (!x.is_floating() && !x.is_integer()) fail(fmt::format("'{}' must be a number", qualified(key)));
+        return value_of(x, qualified(key));
     }
     double number(const std::string& key, double fallback) { return has(key) ? number(key) : fallback; }
+    // A value > 0, and normal: a subnormal density or modulus underflows the masses and stiffnesses made from it.
     double positive(const std::string& key, double fallback)
     {
         const double d = number(key, fallback);
-        if (!(d > 0.0)) fail(fmt::format("'{}' must be > 0 (got {})", qualified(key), d));
+        if (!(d > 0.0)) fail(fmt::format("'{}' must be > 0 (got {})", qualified(key), shown(key, d)));
+        if (d < std::numeric_limits<double>::min())
+            fail(fmt::format("'{}' = {} is below the smallest normal double, {:g}", qualified(key), shown(key, d), std::numeric_limits<double>::min()));
         return d;
     }
     double non_negative(const std::string& key, double fallback)
     {
         const double d = number(key, fallback);
-        if (d < 0.0) fail(fmt::format("'{}' must be >= 0 (got {})", qualified(key), d));
+        if (d < 0.0) fail(fmt::format("'{}' must be >= 0 (got {})", qualified(key), shown(key, d)));
         return d;
     }
+    // The value of `key` as the file writes it (the number that was read when the key is absent).
+    std::string shown(const std::string& key, double d) const
+    {
+        return has(key) ? written(v_.as_table().at(key)) : fmt::format("{}", d);
+    }
+    double value_of(const toml::value& x, const std::string& name) const
+    {
+        if (const std::string problem = toml_number_problem(x, name); !problem.empty()) fail(problem);
+        return x.is_floating() ? x.as_floating() : double(x.as_integer());
+    }
+    static std::string written(const toml::value& x) { return toml_written(x); }
     // An integer in [lo, hi]. The message quotes the number as written: toml11 clamps a literal beyond
     // 64 bits to the nearest limit, and a narrowing cast would wrap (4294967297 into an int is 1).
     std::int64_t integer(const std::string& key, std::int64_t fallback, std::int64_t lo, std::int64_t hi)
@@ -93,17 +105,14 @@ public:
         const auto& x = raw(key);
         if (!x.is_integer()) fail(fmt::format("'{}' must be an integer", qualified(key)));
         const std::int64_t v = x.as_integer();
-        const auto where = x.location();
-        std::string text = std::to_string(v);
-        if (where.column() >= 1 && where.column() - 1 + where.region() <= where.line_str().size())
-            text = where.line_str().substr(where.column() - 1, where.region());
+        const std::string text = written(x);
         std::string digits;
         for (char c : text)
             if (c != '_' && c != '+') digits += c;
         const bool clamped = (v == std::numeric_limits<std::int64_t>::max() || v == std::numeric_limits<std::int64_t>::min()) &&
                              digits != std::to_string(v);
         if (clamped || v < lo || v > hi)
-            fail(fmt::format("'{}' = {} is out of range ({} to {})", qualified(key), printable(text), lo, hi));
+            fail(fmt::format("'{}' = {} is out of range ({} to {})", qualified(key), text, lo, hi));
         return v;
     }
     bool boolean(const std::string& key, bool fallback)
@@ -129,12 +138,8 @@ public:
             fail(fmt::format("'{}' must be an array of {} numbers", qualified(key), n));
         std::vector<double> out;
         for (const auto& e : x.as_array()) {
-            double d;
-            if (e.is_floating()) d = e.as_floating();
-            else if (e.is_integer()) d = double(e.as_integer());
-            else fail(fmt::format("'{}' must be an array of {} numbers", qualified(key), n));
-            if (!std::isfinite(d)) fail(fmt::format("'{}' must be finite (got {})", qualified(key), d));
-            out.push_back(d);
+            if (!e.is_floating() && !e.is_integer()) fail(fmt::format("'{}' must be an array of {} numbers", qualified(key), n));
+            out.push_back(value_of(e, qualified(key)));
         }
         return out;
     }
@@ -198,9 +203,12 @@ Material read_wall_material(Table t)
 
 Vec3d unit(Vec3d n, const Table& t)
 {
-    const double len = std::sqrt(dot(n, n));
-    if (!(len > 0.0)) t.fail(fmt::format("'{}' must be a non-zero vector", t.qualified("normal")));
-    return n / len;
+    // Scaled by its largest component first, so that neither n·n overflows (1e200) nor underflows (1e-200):
+    // any non-zero vector gives a unit normal.
+    const double big = std::max({std::abs(n.x), std::abs(n.y), std::abs(n.z)});
+    if (!(big > 0.0)) t.fail(fmt::format("'{}' must be a non-zero vector", t.qualified("normal")));
+    n = n / big;
+    return n / std::sqrt(dot(n, n));
 }
 
 // TOML parse errors from toml11 span several lines; keep the first line and the line number.
@@ -244,6 +252,36 @@ std::size_t invalid_utf8(const std::string& text)
         else if (c == 0xF4) len = cont(i + 1, 0x80, 0x8F) && cont(i + 2, 0x80, 0xBF) && cont(i + 3, 0x80, 0xBF) ? 4 : 0;
         if (len == 0) return i;
         i += len;
+    }
+    return std::string::npos;
+}
+
+// toml11 parses arrays and inline tables recursively: 20000 '[' exhaust the stack (SIGSEGV, no message).
+// A scene nests a few levels; deeper text is refused before toml11 sees it.
+constexpr int kMaxNesting = 32;
+
+// Offset of the bracket or brace that opens level kMaxNesting + 1 (strings and comments skipped), or npos.
+std::size_t too_deep(const std::string& text)
+{
+    const std::size_t n = text.size();
+    int depth = 0;
+    for (std::size_t i = 0; i < n; ++i) {
+        const char c = text[i];
+        if (c == '#') {
+            while (i < n && text[i] != '\n') ++i;
+        } else if (c == '"' || c == '\'') {
+            const std::string triple(3, c);
+            const bool multi = text.compare(i, 3, triple) == 0, escapes = c == '"';
+            for (i += multi ? 3 : 1; i < n; ++i) {
+                if (escapes && text[i] == '\\') { ++i; continue; }
+                if (multi ? text.compare(i, 3, triple) == 0 : text[i] == c || text[i] == '\n') break;  // toml11 reports an open string
+            }
+            if (multi) i += 2;
+        } else if (c == '[' || c == '{') {
+            if (++depth > kMaxNesting) return i;
+        } else if ((c == ']' || c == '}') && depth > 0) {
+            --depth;
+        }
     }
     return std::string::npos;
 }
@@ -296,7 +334,8 @@ ContactParams<double> Scene::contact_params() const
 
 std::uint64_t Scene::fingerprint(std::size_t particle_count) const
 {
-    // FNV-1a over the physics that a saved state depends on.
+    // FNV-1a over the physics that a saved state depends on, from the state format's offset basis
+    // (docs/state-format.md: not the standard one, kept so that saved states stay readable).
     std::uint64_t h = 1469598103934665603ull;
     auto mix = [&h](const void* p, std::size_t n) {
         const auto* b = static_cast<const unsigned char*>(p);
@@ -319,6 +358,9 @@ Scene parse_scene(const std::string& text, const std::string& label)
     if (const std::size_t bad = invalid_utf8(text); bad != std::string::npos)
         throw Error(fmt::format("{}: not UTF-8 text (byte {} on line {}): a scene is a TOML file", label, bad,
                                 1 + std::count(text.begin(), text.begin() + std::ptrdiff_t(bad), '\n')));
+    if (const std::size_t deep = too_deep(text); deep != std::string::npos)
+        throw Error(fmt::format("{}: arrays or inline tables nested deeper than {} levels (line {}): a scene needs a few", label,
+                                kMaxNesting, 1 + std::count(text.begin(), text.begin() + std::ptrdiff_t(deep), '\n')));
     toml::value root;
     try {
         std::istringstream in(text);
@@ -335,10 +377,12 @@ Scene parse_scene(const std::string& text, const std::string& label)
     s.material = top.has("material") ? read_material(top.table("material")) : Material{};
     if (top.has("wall_material")) s.wall_material = read_wall_material(top.table("wall_material"));
 
+    std::string dt_text;  // as written, for the check against the scene's precision below
     {
         Table t = top.table("time");
         s.dt = t.number("dt");
-        if (!(s.dt > 0.0)) t.fail(fmt::format("'time.dt' must be > 0 (got {})", s.dt));
+        if (!(s.dt > 0.0)) t.fail(fmt::format("'time.dt' must be > 0 (got {})", t.shown("dt", s.dt)));
+        dt_text = t.shown("dt", s.dt);
         s.gravity = t.vec("gravity", s.gravity);
     }
     {
@@ -354,7 +398,12 @@ Scene parse_scene(const std::string& text, const std::string& label)
         for (Table& t : top.tables("wall")) {
             Wall w;
             if (t.has("face")) {
-                w = box_face(s.domain, t.string("face", ""));
+                const std::string face = t.string("face", "");
+                try {
+                    w = box_face(s.domain, face);
+                } catch (const Error& e) {
+                    t.fail(fmt::format("'{}': {}", t.qualified("face"), e.what()));
+                }
             } else {
                 w.name = t.string("name", fmt::format("wall{}", s.walls.size()));
                 w.point = t.vec("point");
@@ -401,6 +450,10 @@ Scene parse_scene(const std::string& text, const std::string& label)
         s.integrator = {*sc, *pr};
     }
 
+    if (s.dt < min_time_step(s.integrator.precision))
+        top.fail(fmt::format("'time.dt' = {} is below {:g} s, where the Gear values' Δt²/2·a underflows in {} (the run would turn "
+                             "to NaN)", dt_text, min_time_step(s.integrator.precision), name(s.integrator.precision)));
+
     if (top.has("contact")) s.contact_model = parse_contact_model(top.raw("contact"), label);
 
     Table p = top.table("particles");
@@ -413,7 +466,7 @@ Scene parse_scene(const std::string& text, const std::string& label)
         const auto r = p.numbers("radius", 2);
         g.radius_min = r[0];
         g.radius_max = r[1];
-        if (!(g.radius_min > 0.0) || g.radius_max < g.radius_min)
+        if (!(g.radius_min >= std::numeric_limits<double>::min()) || g.radius_max < g.radius_min)
             p.fail(fmt::format("'particles.radius' must be [min, max] with 0 < min <= max (got [{}, {}])", r[0], r[1]));
         const auto v = p.has("speed") ? p.numbers("speed", 2) : std::vector<double>{0.0, 0.0};
         g.speed_min = v[0];
@@ -438,7 +491,9 @@ Scene parse_scene(const std::string& text, const std::string& label)
         for (Table& t : p.tables("particle")) {
             ParticleInit q;
             q.radius = t.number("radius");
-            if (!(q.radius > 0.0)) t.fail(fmt::format("'{}' must be > 0 (got {})", t.qualified("radius"), q.radius));
+            if (!(q.radius > 0.0)) t.fail(fmt::format("'{}' must be > 0 (got {})", t.qualified("radius"), t.shown("radius", q.radius)));
+            if (q.radius < std::numeric_limits<double>::min())
+                t.fail(fmt::format("'{}' = {} is below the smallest normal double", t.qualified("radius"), t.shown("radius", q.radius)));
             q.position = t.vec("position");
             q.velocity = t.vec("velocity", Vec3d{});
             q.angular_velocity = t.vec("angular_velocity", Vec3d{});

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include <fmt/format.h>
 
@@ -23,14 +24,14 @@ double hertz_contact_time(double mstar, double rstar, double estar, double speed
 double fastest_wall_speed(const State& state)
 {
     double vw = 0.0;
-    for (const Wall& w : state.walls) vw = std::max(vw, std::sqrt(dot(w.velocity, w.velocity)));
+    for (const Wall& w : state.walls) vw = std::max(vw, std::hypot(w.velocity.x, w.velocity.y, w.velocity.z));  // no overflow of v²
     return vw;
 }
 
 double explained_speed(const Scene& scene, const State& state)
 {
     double v0 = 0.0;
-    for (const Vec3d& v : state.trans.v) v0 = std::max(v0, std::sqrt(dot(v, v)));
+    for (const Vec3d& v : state.trans.v) v0 = std::max(v0, std::hypot(v.x, v.y, v.z));  // 1e200 m/s is refused, not inf
     const Vec3d ext = scene.domain.max - scene.domain.min;
     const double fall = std::sqrt(2.0 * std::sqrt(dot(scene.gravity, scene.gravity)) * std::sqrt(dot(ext, ext)));
     return v0 + fall + fastest_wall_speed(state);
@@ -121,8 +122,61 @@ double elastic_energy(const std::vector<Vec3d>& x, const std::vector<double>& ra
     return e;
 }
 
+void check_magnitudes(const Scene& scene, const State& state)
+{
+    const Precision precision = scene.integrator.precision;
+    if (!(scene.dt >= min_time_step(precision)))
+        throw Error(fmt::format("{}: time step {:g} s is below {:g} s, where the Gear values' Δt²/2·a underflows in {}", scene.name,
+                                scene.dt, min_time_step(precision), name(precision)));
+    auto normal = [](double x) { return std::isfinite(x) && x >= std::numeric_limits<double>::min(); };
+    for (std::size_t i = 0; i < state.size(); ++i) {
+        const double m = sphere_mass(state.radius[i], scene.material.density);
+        if (!normal(m) || !normal(sphere_inertia(state.radius[i], m)))
+            throw Error(fmt::format("{}: particle {} of radius {:g} m and density {:g} kg/m³ has a mass of {:g} kg, beyond what a double "
+                                    "holds (its mass or moment of inertia over- or underflows)", scene.name, i, state.radius[i],
+                                    scene.material.density, m));
+    }
+    const ContactParams<double> p = scene.contact_params();
+    if (!normal(p.hertz_pp) || !normal(p.hertz_pw))
+        throw Error(fmt::format("{}: the Hertz stiffness (4/3)E* of {:g} Pa is beyond what a double holds (young = {:g} Pa)", scene.name,
+                                std::min(p.hertz_pp, p.hertz_pw), scene.material.young));
+    double rmin = state.radius.front();
+    for (double r : state.radius) rmin = std::min(rmin, r);
+    if (!normal(rayleigh_time(scene.material, rmin)))
+        throw Error(fmt::format("{}: the Rayleigh time of the smallest grain, {:g} s, is beyond what a double holds (density {:g} kg/m³, "
+                                "shear modulus {:g} Pa, radius {:g} m)", scene.name, rayleigh_time(scene.material, rmin),
+                                scene.material.density, scene.material.shear_modulus(), rmin));
+    const double v = impact_speed_bound(scene, state);
+    if (!std::isfinite(v))
+        throw Error(fmt::format("{}: the largest impact speed overflows a double (a grain's or a wall's speed near 1e308 m/s)", scene.name));
+    const ContactTime ct = shortest_contact_time(scene, state, v);
+    if (v > 0.0 && (state.size() > 1 || !state.walls.empty()) && !normal(ct.tc))
+        throw Error(fmt::format("{}: the Hertz contact time of young = {:g} Pa at the impact speed {:g} m/s is {:g} s, beyond what a double "
+                                "holds", scene.name, scene.material.young, v, ct.tc));
+}
+
+std::string check_continued_walls(const Scene& scene, const State& state)
+{
+    if (scene.state_file.empty()) return {};
+    const Vec3d ext = scene.domain.max - scene.domain.min;
+    const double tolerance = 1e-12 * std::hypot(ext.x, ext.y, ext.z);
+    for (const Wall& w : scene.walls)
+        for (const Wall& kept : state.walls) {  // the continued walls: the state's, or the scene's where the state has none
+            if (kept.name != w.name) continue;
+            const Vec3d p = kept.point_at(state.step, scene.dt);
+            if (w.normal == kept.normal && std::abs(dot(w.point - p, kept.normal)) <= tolerance) continue;
+            return fmt::format("wall '{}' of the scene (point ({:g}, {:g}, {:g}), normal ({:g}, {:g}, {:g})) is not where the state file "
+                               "has it at step {} (point ({:g}, {:g}, {:g}), normal ({:g}, {:g}, {:g})): a continued wall stands where "
+                               "the state left it, so the scene's point and normal are not used",
+                               w.name, w.point.x, w.point.y, w.point.z, w.normal.x, w.normal.y, w.normal.z, state.step, p.x, p.y, p.z,
+                               kept.normal.x, kept.normal.y, kept.normal.z);
+        }
+    return {};
+}
+
 std::string check_time_step(const Scene& scene, const State& state)
 {
+    check_magnitudes(scene, state);
     double rmin = state.radius.front();
     for (double r : state.radius) rmin = std::min(rmin, r);
     const double tr = rayleigh_time(scene.material, rmin);

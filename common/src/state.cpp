@@ -40,6 +40,8 @@ private:
     std::uint64_t s_;
 };
 
+// FNV-1a from the offset basis 1469598103934665603, not the standard 14695981039346656037 (a digit short):
+// every saved state carries it, so it stays (docs/state-format.md).
 std::uint64_t fnv1a(const std::string& bytes)
 {
     std::uint64_t h = 1469598103934665603ull;

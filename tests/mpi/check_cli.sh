@@ -26,6 +26,7 @@ refused "is not auto or PxPyPz" 2 "$demmat_mpi" run "$src/scenes/head_on.toml" -
 refused "runs the mpi variant only, not 'arrays'" 2 "$demmat_mpi" run "$src/scenes/head_on.toml" --variant arrays
 refused "run it with demmat" 2 "$demmat_mpi" scene paper
 refused "cannot open" 2 "$demmat_mpi" run no_such_scene.toml
+refused "an empty name" 2 "$demmat_mpi" run "$src/scenes/head_on.toml" --json ""
 refused "REFERENCE,mpi" 2 "$demmat_mpi" compare "$src/scenes/head_on.toml" --variants mpi,arrays
 
 bed="$src/scenes/dense_bed_2000.toml"

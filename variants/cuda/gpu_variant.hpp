@@ -5,6 +5,7 @@
 // (host_backend.hpp) runs the same kernel bodies on the CPU in shuffled block order. Host and backend
 // memory meet only in init, snapshot, save and counts, and in one status read per search (32 bytes:
 // capacity overflows and runaway positions, which stop the run as in the arrays variant).
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <string>
@@ -22,6 +23,8 @@ void throw_status(const unsigned long long (&status)[kStatusWords], std::uint32_
                   std::uint32_t cap_walls, std::size_t walls);
 // Refuses a scene the variant cannot hold (more than kMaxWalls walls, 2^32 − 1 particles).
 void check_size(std::size_t particles, std::size_t walls);
+// The error for a state whose contacts overflow a row of stretches (`cap` entries) at `particle`.
+[[noreturn]] void throw_state_overflow(std::uint32_t cap, bool wall, std::int64_t particle);
 
 template <class B, class M>
 class GpuVariant final : public Variant {
@@ -50,6 +53,7 @@ public:
         v_.cap_walls = std::uint32_t(scene.capacity.wall_contacts_per_particle);
         v_.row_cap = 2 * v_.cap_above;  // partners on both sides
         v_.params = setup.contact;
+        v_.memory = setup.memory;
         v_.gravity = scene.gravity;
         v_.gear = setup.gear;
         if constexpr (!M::polydisperse)  // one radius and mass: the contacts' coefficients once per run
@@ -80,6 +84,10 @@ public:
         for (std::uint64_t** a : {&v_.key, &v_.sorted_key, &v_.cell_tmp}) *a = be_.template alloc<std::uint64_t>(n);
         for (std::uint32_t** a : {&v_.bucket_begin, &v_.bucket_end}) *a = be_.template alloc<std::uint32_t>(buckets);
         v_.status = be_.template alloc<unsigned long long>(kStatusWords);
+        if constexpr (M::memory) {  // two sets of rows each for pairs (both sides) and walls, zero: no contact yet
+            for (StretchRows* r : {&v_.pairs_then, &v_.pairs_now}) alloc_rows(*r, v_.row_cap);
+            for (StretchRows* r : {&v_.walls_then, &v_.walls_now}) alloc_rows(*r, v_.cap_walls);
+        }
 
         // Slot = id to start with (the first search sorts).
         std::array<std::vector<double>, kGearArrays> cols;
@@ -93,6 +101,7 @@ public:
         be_.upload(v_.p.mass, setup.mass.data(), n);
         be_.upload(v_.p.inertia, setup.inertia.data(), n);
         be_.upload(v_.p.id, ids.data(), n);
+        if constexpr (M::memory) load_stretches(s.stretches);
         be_.sync();
     }
 
@@ -125,6 +134,10 @@ public:
     void forces() override
     {
         be_.launch(v_.n, Forces<M>{v_});
+        if constexpr (M::memory) {  // this evaluation's rows are the next one's "then"
+            std::swap(v_.pairs_then, v_.pairs_now);
+            std::swap(v_.walls_then, v_.walls_now);
+        }
         be_.sync();
     }
 
@@ -163,6 +176,12 @@ public:
         }
         const std::vector<double> r = fetch(v_.p.radius, n);
         for (std::size_t s = 0; s < n; ++s) out.radius[id[s]] = r[s];
+        out.stretches.clear();
+        if constexpr (M::memory) {
+            save_stretches(v_.pairs_then, id, false, out.stretches);
+            save_stretches(v_.walls_then, id, true, out.stretches);
+            std::sort(out.stretches.begin(), out.stretches.end());  // the canonical order: by particle, pairs, then walls
+        }
     }
 
     ContactCounts counts() const override
@@ -187,6 +206,75 @@ private:
         return out;
     }
 
+    void alloc_rows(StretchRows& r, std::uint32_t cap)
+    {
+        r.cap = cap;
+        r.count = be_.template alloc<std::uint32_t>(v_.n);
+        r.key = be_.template alloc<std::uint32_t>(std::size_t(v_.n) * cap);
+        r.spring = be_.template alloc<double>(3 * std::size_t(kSprings<M>) * v_.n * cap);
+    }
+
+    // A state's stretches into the "then" rows, slot = id as init leaves it: each pair in both of its
+    // particles' rows, each wall contact in its particle's, keys ascending (the canonical order gives it).
+    void load_stretches(std::vector<ContactStretch> in)
+    {
+        if (in.empty()) return;  // the rows are zero: no contact yet
+        std::sort(in.begin(), in.end());
+        const std::size_t n = v_.n;
+        struct Host {
+            std::vector<std::uint32_t> count, key;
+            std::vector<double> spring;
+        } pairs, walls;
+        for (Host* h : {&pairs, &walls}) h->count.assign(n, 0);
+        pairs.key.assign(n * v_.row_cap, 0);
+        walls.key.assign(n * v_.cap_walls, 0);
+        pairs.spring.assign(3 * kSprings<M> * n * v_.row_cap, 0.0);
+        walls.spring.assign(3 * kSprings<M> * n * v_.cap_walls, 0.0);
+        auto add = [&](Host& h, std::uint32_t cap, bool wall, std::uint32_t s, std::uint32_t key, const ContactStretch& c) {
+            if (h.count[s] == cap) throw_state_overflow(cap, wall, s);
+            const std::size_t k = h.count[s]++;
+            h.key[k * n + s] = key;
+            Stretch<double> st{c.tangential, c.rolling};
+            std::size_t comp = 0;
+            for_each_spring<M>(st, [&](const Vec3<double>& x) {
+                for (double value : {x.x, x.y, x.z}) h.spring[(comp++ * cap + k) * n + s] = value;
+            });
+        };
+        for (const ContactStretch& c : in) {  // pairs below a particle come before its own (i ascending)
+            const auto i = std::uint32_t(c.i), j = std::uint32_t(c.partner);
+            if (c.wall) {
+                add(walls, v_.cap_walls, true, i, j, c);
+            } else {
+                add(pairs, v_.row_cap, false, i, j, c);
+                add(pairs, v_.row_cap, false, j, i, c);
+            }
+        }
+        for (auto [h, r] : {std::pair{&pairs, &v_.pairs_then}, std::pair{&walls, &v_.walls_then}}) {
+            be_.upload(r->count, h->count.data(), h->count.size());
+            be_.upload(r->key, h->key.data(), h->key.size());
+            be_.upload(r->spring, h->spring.data(), h->spring.size());
+        }
+    }
+
+    // The live contacts of the last evaluation as a state holds them: each pair once, from its lower id's row.
+    void save_stretches(const StretchRows& r, const std::vector<std::uint32_t>& id, bool wall, std::vector<ContactStretch>& out) const
+    {
+        const std::size_t n = v_.n;
+        const std::vector<std::uint32_t> count = fetch(r.count, n), key = fetch(r.key, n * r.cap);
+        const std::vector<double> spring = fetch(r.spring, 3 * kSprings<M> * n * r.cap);
+        for (std::size_t s = 0; s < n; ++s)
+            for (std::size_t k = 0; k < count[s]; ++k) {
+                const std::uint32_t partner = key[k * n + s];
+                if (!wall && partner < id[s]) continue;  // the pair's other copy, in its lower particle's row
+                Stretch<double> st{};
+                std::size_t comp = 0;
+                for_each_spring<M>(st, [&](Vec3<double>& x) {
+                    for (double* value : {&x.x, &x.y, &x.z}) *value = spring[(comp++ * r.cap + k) * n + s];
+                });
+                out.push_back({std::int64_t(id[s]), std::int64_t(partner), wall, st.t, st.r});
+            }
+    }
+
     // The walls' positions of this step, computed on the host as the arrays variant does and passed to
     // the kernels by value (View::walls).
     void place_walls(std::int64_t step)
@@ -202,15 +290,16 @@ private:
     std::int64_t step_ = 0;
 };
 
-// A DispatchingVariant whose init() picks GpuVariant<B, M> for the smallest model the scene needs.
+// A DispatchingVariant whose init() picks GpuVariant<B, M> for the smallest model the scene needs, with its
+// contact law (every law of physics.md §9).
 template <class B>
 std::unique_ptr<Variant> make_dispatching(std::function<B()> backend)
 {
     return std::make_unique<DispatchingVariant>([backend](const Setup& setup) {
-        return with_model(model_for(setup), [&]<class M>() -> std::unique_ptr<Variant> {
+        return with_law_model(model_for(setup), [&]<class M>() -> std::unique_ptr<Variant> {
             return std::make_unique<GpuVariant<B, M>>(backend());
         });
-    });
+    }, false, true);
 }
 
 } // namespace demmat::gpu

@@ -10,6 +10,7 @@
 #include <cmath>
 #include <cstdint>
 
+#include "contact_rows.hpp"
 #include "demmat/contact_law.hpp"
 #include "demmat/gear.hpp"
 #include "demmat/host_device.hpp"
@@ -61,6 +62,9 @@ struct View {
     std::uint32_t cap_above = 0, cap_walls = 0;   // scene capacities
     unsigned long long* status = nullptr;         // kStatusWords words
     ContactParams<double> params;
+    MemoryParams<double> memory;                  // a §9 law's constants (zero for the paper's law)
+    StretchRows pairs_then, walls_then;           // a law with memory: the last evaluation's rows, at the slots of then
+    StretchRows pairs_now, walls_now;             // this evaluation's, at the current slots (contact_rows.hpp)
     Coefficients<double> mono_pp, mono_pw;
     Vec3<double> gravity;
     GearCoefficients<double> gear;
@@ -284,7 +288,9 @@ struct Search {
 
 // Partners ascending by id (below it, then above it), each pair by the shared law with the lower id as
 // i; the force on the higher one is +(−F_i) and its torque the law's t_j, as in the arrays variant's
-// loop; then the walls in wall order; then a = F/m + g and α = T/I.
+// loop; then the walls in wall order; then a = F/m + g and α = T/I. Under a law with memory each contact
+// takes its stretches from the particle's row of the last evaluation (at the slot it had then) by key,
+// and a live one writes them, advanced, to its row of this evaluation (contact_rows.hpp).
 template <class M>
 struct Forces {
     View v;
@@ -297,35 +303,46 @@ struct Forces {
         const Vec3<double> xp = get(P.gear[0], n, p), vp = get(P.gear[1], n, p), wp = get(P.gear[7], n, p);
         const double rp = P.radius[p], mp = P.mass[p];
         Vec3<double> f{}, t{};
-        std::uint32_t contacts = 0, wall_contacts = 0;
+        std::uint32_t contacts = 0, wall_contacts = 0, live = 0;
+        const std::uint32_t then = M::memory ? v.sorted_slot[p] : p;  // this particle's slot at the last evaluation
+        RowReader<M> pairs_then(v.pairs_then, n, then);
         const std::uint64_t* row = v.row + std::uint64_t(p) * v.row_cap;
         for (std::uint32_t k = 0; k < v.row_count[p]; ++k) {
             const std::uint32_t q = std::uint32_t(row[k]), iq = std::uint32_t(row[k] >> 32);
             const Vec3<double> xq = get(P.gear[0], n, q), vq = get(P.gear[1], n, q), wq = get(P.gear[7], n, q);
             ContactForce<double> c;
+            Stretch<double> s{};
+            if constexpr (M::memory) s = pairs_then.take(iq);
             if (iq < ip) {
-                if (!particle_contact<M>(xq, xp, vq, vp, wq, wp, P.radius[q], rp, P.mass[q], mp, v.params, v.mono_pp, c)) continue;
+                if (!pair_law<M>(xq, xp, vq, vp, wq, wp, P.radius[q], rp, P.mass[q], mp, v.params, v.memory, v.mono_pp, s, c)) continue;
                 f += -c.f_i;
                 if constexpr (M::rotation) t += c.t_j;
             } else {
-                if (!particle_contact<M>(xp, xq, vp, vq, wp, wq, rp, P.radius[q], mp, P.mass[q], v.params, v.mono_pp, c)) continue;
+                if (!pair_law<M>(xp, xq, vp, vq, wp, wq, rp, P.radius[q], mp, P.mass[q], v.params, v.memory, v.mono_pp, s, c)) continue;
                 f += c.f_i;
                 if constexpr (M::rotation) t += c.t_i;
                 ++contacts;
             }
+            if constexpr (M::memory) put_stretch<M>(v.pairs_now, n, p, live++, iq, s);
         }
+        if constexpr (M::memory) v.pairs_now.count[p] = live;
         if constexpr (M::walls) {
             const std::uint32_t mask = v.wall_mask[p];
+            RowReader<M> walls_then(v.walls_then, n, then);
             for (int w = 0; w < v.walls.count; ++w) {
                 if (!(mask >> w & 1u)) continue;
                 ContactForce<double> c;
-                if (!wall_contact<M>(xp, vp, wp, rp, mp, v.walls.point[w], v.walls.normal[w], v.walls.velocity[w], v.params,
-                                     v.mono_pw, c))
+                Stretch<double> s{};
+                if constexpr (M::memory) s = walls_then.take(std::uint32_t(w));
+                if (!wall_law<M>(xp, vp, wp, rp, mp, v.walls.point[w], v.walls.normal[w], v.walls.velocity[w], v.params, v.memory,
+                                 v.mono_pw, s, c))
                     continue;
                 f += c.f_i;
                 if constexpr (M::rotation) t += c.t_i;
+                if constexpr (M::memory) put_stretch<M>(v.walls_now, n, p, wall_contacts, std::uint32_t(w), s);
                 ++wall_contacts;
             }
+            if constexpr (M::memory) v.walls_now.count[p] = wall_contacts;
         }
         put(v.force, n, p, f);
         put(v.torque, n, p, t);

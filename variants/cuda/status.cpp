@@ -28,6 +28,15 @@ void throw_status(const unsigned long long (&status)[kStatusWords], std::uint32_
     (void)row_cap;
 }
 
+void throw_state_overflow(std::uint32_t cap, bool wall, std::int64_t particle)
+{
+    if (wall)
+        throw CapacityError(fmt::format("the state holds more wall contacts of particle {} than capacity.wall_contacts_per_particle = {}",
+                                        particle, cap));
+    throw CapacityError(fmt::format("the state holds more contacts of particle {} than the cuda variant's rows of {} (both sides, twice "
+                                    "capacity.contacts_per_particle = {})", particle, cap, cap / 2));
+}
+
 void check_size(std::size_t particles, std::size_t walls)
 {
     if (walls > std::size_t(kMaxWalls))

@@ -105,7 +105,7 @@ namespace detail {
 // The branches of the law below are selects (`cond ? a : b`, lane by lane for a pack of lanes,
 // lanes.hpp), so one text serves a scalar T and a pack; S is T's scalar, the parameters' type.
 template <class T>
-inline Vec3<T> select(const auto& cond, const Vec3<T>& a, const Vec3<T>& b)
+DEMMAT_HD inline Vec3<T> select(const auto& cond, const Vec3<T>& a, const Vec3<T>& b)
 {
     return {cond ? a.x : b.x, cond ? a.y : b.y, cond ? a.z : b.z};
 }
@@ -113,7 +113,7 @@ inline Vec3<T> select(const auto& cond, const Vec3<T>& a, const Vec3<T>& b)
 // A stretch turned into the current tangent plane with its length kept (§9 step 1), when its normal
 // part matters: |ξ·n|·k > 10⁻¹⁰·cap; ξ ← 0 when its projection vanishes.
 template <class T, class S>
-inline Vec3<T> to_tangent_plane(const Vec3<T>& xi, const Vec3<T>& n, T k, T cap)
+DEMMAT_HD inline Vec3<T> to_tangent_plane(const Vec3<T>& xi, const Vec3<T>& n, T k, T cap)
 {
     const T zero{};
     const T xn = dot(xi, n);
@@ -130,7 +130,7 @@ inline Vec3<T> to_tangent_plane(const Vec3<T>& xi, const Vec3<T>& n, T k, T cap)
 // §9 step 3: the trial force f0 = −k·ξ − η·vel capped at `cap`, ξ set back to the stretch of the capped
 // force where the contact slides (and kept where |ξ| = 0, with no force).
 template <class T, class S>
-inline Vec3<T> capped(Vec3<T>& xi, const Vec3<T>& vel, T k, T eta, T cap)
+DEMMAT_HD inline Vec3<T> capped(Vec3<T>& xi, const Vec3<T>& vel, T k, T eta, T cap)
 {
     const T zero{};
     const Vec3<T> f0 = (-k) * xi - eta * vel;
@@ -148,7 +148,7 @@ inline Vec3<T> capped(Vec3<T>& xi, const Vec3<T>& vel, T k, T eta, T cap)
 // plane, advanced by vel·Δt, the force capped. Returns the force; `advance` false evaluates without moving
 // the stretch on (t = 0).
 template <class T, class S>
-inline Vec3<T> spring(Vec3<T>& xi, const Vec3<T>& n, const Vec3<T>& vel, T k, T eta, T cap, S dt, bool advance)
+DEMMAT_HD inline Vec3<T> spring(Vec3<T>& xi, const Vec3<T>& n, const Vec3<T>& vel, T k, T eta, T cap, S dt, bool advance)
 {
     xi = to_tangent_plane<T, S>(xi, n, k, cap);
     if (advance) xi = xi + splat<T>(dt) * vel;
@@ -159,7 +159,8 @@ inline Vec3<T> spring(Vec3<T>& xi, const Vec3<T>& n, const Vec3<T>& vel, T k, T 
 // last evaluation, so ξ = ζ + (Δt/2)·vel is the trapezoidal rule; a store of exact zeros is a new contact,
 // whose stretch is vel·τ, τ the time since its onset within this step (`onset`).
 template <class T, class S>
-inline Vec3<T> spring_trapezoidal(Vec3<T>& zeta, const Vec3<T>& n, const Vec3<T>& vel, T k, T eta, T cap, S dt, T onset, bool advance)
+DEMMAT_HD inline Vec3<T> spring_trapezoidal(Vec3<T>& zeta, const Vec3<T>& n, const Vec3<T>& vel, T k, T eta, T cap, S dt, T onset,
+                                            bool advance)
 {
     const T zero{};
     const T half = splat<T>(S(0.5) * dt);
@@ -176,7 +177,7 @@ inline Vec3<T> spring_trapezoidal(Vec3<T>& zeta, const Vec3<T>& n, const Vec3<T>
 // and 8·G*. Writes the force on i, its tangential part and the rolling torque on i (the partner's is
 // minus it); advances the stretches in `s`.
 template <class M, class T, class S>
-inline void memory_law(const Vec3<T>& n, T h, const Vec3<T>& u, const Vec3<T>& spin, T rstar, T mstar, S hertz, S shear8,
+DEMMAT_HD inline void memory_law(const Vec3<T>& n, T h, const Vec3<T>& u, const Vec3<T>& spin, T rstar, T mstar, S hertz, S shear8,
                        const ContactParams<S>& p, const MemoryParams<S>& q, Stretch<T>& s, bool advance, Vec3<T>& f_i,
                        Vec3<T>& f_t, Vec3<T>& t_roll)
 {
@@ -200,27 +201,27 @@ inline void memory_law(const Vec3<T>& n, T h, const Vec3<T>& u, const Vec3<T>& s
             const auto within = un * dt > h;
             onset = within ? h / (within ? un : splat<T>(S(1))) : dt;
         }
-    auto advanced = [&](Vec3<T>& xi, const Vec3<T>& vel, T kk, T eta, T cap) {
-        return q.trapezoidal ? spring_trapezoidal<T, S>(xi, n, vel, kk, eta, cap, q.dt, onset, advance)
-                             : spring<T, S>(xi, n, vel, kk, eta, cap, q.dt, advance);
-    };
     if constexpr (M::history) {
         const T kt = q.mindlin ? shear8 * a : splat<T>(q.kt);
-        f_t = advanced(s.t, ut, kt, q.ratio_t * eta_n, p.mu * fn);
+        const T eta_t = q.ratio_t * eta_n, cap = p.mu * fn;
+        f_t = q.trapezoidal ? spring_trapezoidal<T, S>(s.t, n, ut, kt, eta_t, cap, q.dt, onset, advance)
+                            : spring<T, S>(s.t, n, ut, kt, eta_t, cap, q.dt, advance);
     } else {
         f_t = viscous_friction(ut, fn, k.ct, p.mu);
     }
     f_i = (-fn) * n + f_t;
     if constexpr (M::rolling) {
         const Vec3<T> vr = (-rstar) * cross(spin, n);  // v_r = −R*·(ω_i − ω_j) × n
-        const Vec3<T> fr = advanced(s.r, vr, splat<T>(q.kr), splat<T>(q.gamma_r), q.mu_r * fn);
+        const T kr = splat<T>(q.kr), gamma_r = splat<T>(q.gamma_r), cap_r = q.mu_r * fn;
+        const Vec3<T> fr = q.trapezoidal ? spring_trapezoidal<T, S>(s.r, n, vr, kr, gamma_r, cap_r, q.dt, onset, advance)
+                                         : spring<T, S>(s.r, n, vr, kr, gamma_r, cap_r, q.dt, advance);
         t_roll = (-rstar) * cross(n, fr);  // T_i += −R*·(n × F_r), T_j −= the same
     }
 }
 
 // The pair law once h is known (in every lane whose result is kept).
 template <class M, class T, class S>
-inline void pair_memory_law(const Vec3<T>& dx, T d, T h, const Vec3<T>& vi, const Vec3<T>& vj, const Vec3<T>& wi, const Vec3<T>& wj,
+DEMMAT_HD inline void pair_memory_law(const Vec3<T>& dx, T d, T h, const Vec3<T>& vi, const Vec3<T>& vj, const Vec3<T>& wi, const Vec3<T>& wj,
                             T ri, T rj, T mi, T mj, const ContactParams<S>& p, const MemoryParams<S>& q, Stretch<T>& s, bool advance,
                             ContactForce<T>& out)
 {
@@ -245,7 +246,7 @@ inline void pair_memory_law(const Vec3<T>& dx, T d, T h, const Vec3<T>& vi, cons
 
 // The wall law once h is known.
 template <class M, class T, class S>
-inline void wall_memory_law(T h, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T mi, const Vec3<T>& normal, const Vec3<T>& vw,
+DEMMAT_HD inline void wall_memory_law(T h, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T mi, const Vec3<T>& normal, const Vec3<T>& vw,
                             const ContactParams<S>& p, const MemoryParams<S>& q, Stretch<T>& s, bool advance, ContactForce<T>& out)
 {
     static_assert(M::rotation && M::friction && M::moving_walls, "a §9 law runs on the full model (with_law_model)");
@@ -265,7 +266,7 @@ inline void wall_memory_law(T h, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T m
 // Particle–particle contact under a §9 law, i < j by id: as particle_contact (contact_law.hpp), and the
 // pair's stretches `s` carried in and out. Returns false (and leaves `s` alone) when h <= 0.
 template <class M, class T>
-inline bool particle_contact_memory(const Vec3<T>& xi, const Vec3<T>& xj, const Vec3<T>& vi, const Vec3<T>& vj,
+DEMMAT_HD inline bool particle_contact_memory(const Vec3<T>& xi, const Vec3<T>& xj, const Vec3<T>& vi, const Vec3<T>& vj,
                                     const Vec3<T>& wi, const Vec3<T>& wj, T ri, T rj, T mi, T mj, const ContactParams<T>& p,
                                     const MemoryParams<T>& q, Stretch<T>& s, bool advance, ContactForce<T>& out)
 {
@@ -279,7 +280,7 @@ inline bool particle_contact_memory(const Vec3<T>& xi, const Vec3<T>& xj, const 
 
 // Particle–wall contact under a §9 law: as wall_contact (contact_law.hpp), with the contact's stretches.
 template <class M, class T>
-inline bool wall_contact_memory(const Vec3<T>& xi, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T mi, const Vec3<T>& point,
+DEMMAT_HD inline bool wall_contact_memory(const Vec3<T>& xi, const Vec3<T>& vi, const Vec3<T>& wi, T ri, T mi, const Vec3<T>& point,
                                 const Vec3<T>& normal, const Vec3<T>& vw, const ContactParams<T>& p, const MemoryParams<T>& q,
                                 Stretch<T>& s, bool advance, ContactForce<T>& out)
 {

@@ -11,6 +11,8 @@
 
 namespace demmat {
 
+// The temporary file has a fresh name (FILE.tmpPID, created with O_EXCL, never through a symbolic link),
+// and an existing FILE that is not a regular file (a device, a pipe, a folder) is refused, never replaced.
 void write_atomically(const std::filesystem::path& file, const std::function<void(std::ostream&)>& write);
 void write_atomically(const std::filesystem::path& file, const std::string& content);
 
@@ -27,8 +29,12 @@ std::string read_input_file(const std::filesystem::path& file, const std::string
 // An input a command reads, as an output must not overwrite it: (path, what it is, e.g. "scene file").
 using NamedPath = std::pair<std::filesystem::path, std::string>;
 
+// Refuses (Error, one line naming `option`) a path that exists and is neither a regular file nor a
+// symbolic link (which the rename replaces, never writes through): a device, a pipe, a socket, a folder.
+void refuse_special_file(const std::filesystem::path& file, const std::string& option);
+
 // Checks an output path before any work, so that a bad path fails in a second, not after the run:
-// not an existing directory, not one of `inputs` (the same file by inode, or by canonical path when it
+// not an existing directory, device, pipe or socket, a name of at most 255 bytes, not one of `inputs` (the same file by inode, or by canonical path when it
 // does not exist yet), and the nearest existing folder above it is a directory this process may write
 // into (write_atomically creates the missing folders below it). `option` names it in the message.
 void check_output_path(const std::filesystem::path& file, const std::string& option, const std::vector<NamedPath>& inputs);

@@ -38,6 +38,17 @@ private:
     std::vector<Written> written_;
 };
 
+// The step of a snapshot file name of the series `stem` (<stem>_<step>.vtp or <stem>_walls_<step>.vtp),
+// or -1 when `name` is not one.
+std::int64_t vtk_snapshot_step(const std::string& name, const std::string& stem);
+
+// Refuses (Error, one line), before a run, every name the series `stem` in `dir` could write for a step in
+// [first, last] (a blow-up writes the failing step, so every step of the run counts) that is one of
+// `others` (the inputs, which must not be overwritten, and the other outputs), or that exists and is not
+// a regular file or a symbolic link (a folder where a snapshot goes would fail only after the run).
+void check_vtk_names(const std::filesystem::path& dir, const std::string& stem, std::int64_t first, std::int64_t last,
+                     const std::vector<std::pair<std::filesystem::path, std::string>>& others);
+
 // The polygon where the plane through `point` with normal `normal` cuts the box, its corners in order
 // around the normal (3 to 6 corners; empty when the plane misses the box or only touches an edge).
 std::vector<Vec3d> plane_in_box(const Vec3d& point, const Vec3d& normal, const Box& box);

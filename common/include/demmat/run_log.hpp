@@ -18,6 +18,10 @@ namespace demmat {
 // this keeps the log's cost to about one percent of the run.
 inline constexpr std::int64_t kDefaultLogEvery = 100;
 
+// `--log -`: the rows go to standard output. The log is a stream written in place (not renamed into
+// place like the other outputs), so a pipe or a terminal is a fine log too.
+inline const std::filesystem::path kStandardOutput = "-";
+
 // One row of the log (columns in docs: see log_header).
 struct LogRow {
     std::int64_t step = 0;
@@ -43,7 +47,7 @@ LogRow measure_log_row(const Snapshot& s, const Setup& setup);
 std::string log_header(std::size_t walls);
 std::string log_line(const LogRow& row);
 
-// Refuses (Error, one line) a log path that cannot be written or would overwrite an input: a folder,
+// Refuses (Error, one line) a log path that cannot be written or would overwrite an input: an empty name, a folder,
 // a file in a folder that does not exist or cannot be written, an unwritable file, or one of `inputs`
 // (the scene file, the state file it reads). Called before the run starts.
 void check_log_path(const std::filesystem::path& log, const std::vector<std::filesystem::path>& inputs);
@@ -72,6 +76,7 @@ private:
     const Setup& setup_;
     std::int64_t every_;
     int fd_ = -1;
+    bool owned_ = true;  // false for standard output, which is not closed
 };
 
 } // namespace demmat

@@ -42,6 +42,23 @@ double stable_fraction_of_contact_time(Integrator scheme);
 // by more than about 1 % for the paper's Gear scheme (docs/stability.md).
 inline constexpr double kWarnFractionOfContactTime = 0.05;
 
+// The smallest Δt a run in precision p can take: the Gear values hold Δt²/2·a, which must stay a normal
+// number, so Δt >= sqrt(2·smallest normal), rounded up (below it the scaled accelerations underflow to
+// zero and the run turns to NaN at its second step).
+inline double min_time_step(Precision p) { return p == Precision::float64 ? 2.2e-154 : 1.7e-19; }
+
+// Refuses (throws Error, one line) a scene whose numbers, each in range, make quantities a double cannot
+// hold: a Δt below min_time_step, a grain's mass or moment of inertia that underflows, a contact
+// stiffness, Rayleigh time, impact speed or Hertz contact time that overflows or underflows. Such a
+// run would end as "unstable" (exit 3) rather than as the bad input it is. check_time_step calls it;
+// a run with --allow-unstable calls it alone.
+void check_magnitudes(const Scene& scene, const State& state);
+
+// A warning (empty if none) when a scene that continues a saved state gives a wall the state knows another
+// plane than the state has it at its step: a continued wall stands where the state left it (continue_walls),
+// so an edit of its point or normal in the scene file is not applied, and the user is told so.
+std::string check_continued_walls(const Scene& scene, const State& state);
+
 // Refuses a time step above the Rayleigh time of the smallest particle (a scene that cannot be stable)
 // and returns a warning (empty if none) when Δt exceeds 0.2 of it, the usual rule of thumb; likewise for
 // the Hertz contact time at the scene's largest impact speed (check_contact_time_step, below).
