@@ -35,6 +35,7 @@ struct Options {
     std::set<int> tests{1, 2, 3, 4, 5, 6, 7, 8};
     double per_tc = 200.0;  // Δt = t_c / per_tc for every run but the integrator study
     bool quick = false;     // every third value of each sweep (a smoke test of the whole pipeline)
+    StretchUpdate stretch_update = StretchUpdate::first_order;  // the history laws' (physics.md §9)
 };
 
 // The integrator study of the brief: tests 1 and 4 with gear5, gear3 and verlet at t_c/50 and t_c/200.
@@ -114,6 +115,7 @@ void run_case(const ChungOoiCase& c, const Options& opt, Outputs& out, std::set<
 int usage()
 {
     std::cerr << "usage: demmat_validation [--out DIR] [--variants a,b] [--tests 1,2,...] [--per-tc N] [--quick]\n"
+                 "       [--stretch-update first_order|trapezoidal]\n"
                  "  the Chung & Ooi tests 1–8 with every law that applies (docs/validation.md); default variants arrays,fast\n";
     return 2;
 }
@@ -137,6 +139,11 @@ int main(int argc, char** argv)
                 for (const std::string& t : split(next())) opt.tests.insert(chung_ooi_test(std::stoi(t)).number);
             } else if (a == "--per-tc") opt.per_tc = std::stod(next());
             else if (a == "--quick") opt.quick = true;
+            else if (a == "--stretch-update") {
+                const std::string u = next();
+                if (u == name(StretchUpdate::trapezoidal)) opt.stretch_update = StretchUpdate::trapezoidal;
+                else if (u != name(StretchUpdate::first_order)) throw Error(fmt::format("--stretch-update '{}': expected first_order or trapezoidal", u));
+            }
             else if (a == "--help" || a == "-h") return usage();
             else throw Error(fmt::format("unknown option '{}' (see --help)", a));
         }
@@ -152,7 +159,7 @@ int main(int argc, char** argv)
                 for (std::size_t iv = 0; iv < t.values.size(); ++iv) {
                     if (opt.quick && iv % 3 != 0) continue;
                     for (const std::string& law : t.laws) {
-                        ChungOoiCase c{k, m.name, t.values[iv], law, opt.per_tc, {}};
+                        ChungOoiCase c{k, m.name, t.values[iv], law, opt.per_tc, {}, opt.stretch_update};
                         run_case(c, opt, out, skipped, ran);
                         if (k != 1 && k != 4) continue;
                         for (Integrator scheme : kStudied)  // the integrator study (gear5 at per_tc is the run above)
@@ -176,7 +183,7 @@ int main(int argc, char** argv)
         }
         const json meta = {{"provenance", provenance_json()},
                            {"chung_ooi", {{"paper", "Chung & Ooi, Granular Matter 13 (2011) 643-656"}, {"tests", std::vector<int>(opt.tests.begin(), opt.tests.end())}}},
-                           {"settings", {{"per_tc", opt.per_tc}, {"quick", opt.quick}, {"variants_asked", opt.variants},
+                           {"settings", {{"per_tc", opt.per_tc}, {"quick", opt.quick}, {"stretch_update", name(opt.stretch_update)}, {"variants_asked", opt.variants},
                                          {"integrator_study", {{"tests", {1, 4}}, {"schemes", {"gear5", "gear3", "verlet"}}, {"per_tc", kStudiedPerTc}}}}},
                            {"variants_ran", std::vector<std::string>(ran.begin(), ran.end())},
                            {"skipped", std::vector<std::string>(skipped.begin(), skipped.end())},

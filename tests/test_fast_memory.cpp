@@ -34,7 +34,8 @@ struct Law {
     bool memory;  // carries stretches
 };
 
-// The laws under test: each spring alone and together, and both restitution-set dampings.
+// The laws under test: each spring alone and together (also with the trapezoidal update), and both
+// restitution-set dampings.
 std::vector<Law> laws()
 {
     ContactModel linear;
@@ -49,6 +50,8 @@ std::vector<Law> laws()
     rolling.kr = 50.0;
     rolling.rolling_damping = 0.05;
     rolling.rolling_friction = 0.2;
+    ContactModel trapezoidal = rolling;  // the trapezoidal stretch update (physics.md §9) on both springs
+    trapezoidal.stretch_update = StretchUpdate::trapezoidal;
     ContactModel tsuji;
     tsuji.damping = NormalDamping::tsuji;
     tsuji.restitution = 0.6;
@@ -58,6 +61,7 @@ std::vector<Law> laws()
     return {{"linear_history", linear, true},
             {"mindlin", mindlin, true},
             {"mindlin_sds", rolling, true},
+            {"mindlin_sds_trapezoidal", trapezoidal, true},
             {"tsuji", tsuji, false},
             {"restitution_linear_history", restitution, true}};
 }

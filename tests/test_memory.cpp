@@ -447,7 +447,7 @@ bool same_bits(T a, T b) { return std::memcmp(&a, &b, sizeof(T)) == 0; }
 // geometry near contact, random velocities and spins, random stretches (some zero, some with a normal
 // part, some long enough to slide). Lanes out of contact keep their stretches and add zeros.
 template <class M, class T, int W>
-void check_memory_lanes(bool mindlin)
+void check_memory_lanes(bool mindlin, bool trapezoidal = false)
 {
     using V = Pack<T, W>;
     const ContactParams<T> p{T(4e5), T(6e5), T(60), T(60), T(0.4)};
@@ -462,6 +462,7 @@ void check_memory_lanes(bool mindlin)
     qd.mu_r = 0.2;
     qd.dt = 1e-5;
     qd.mindlin = mindlin;
+    qd.trapezoidal = trapezoidal;
     const MemoryParams<T> q = qd.as<T>();
     std::uint64_t seed = 12345;
     auto uniform = [&seed](double lo, double hi) {
@@ -568,6 +569,8 @@ TEST(Memory, EveryLaneOfAPackHasTheScalarLawsBits)
     check_memory_lanes<Law, double, native_lanes<double>>(false);
     check_memory_lanes<Law, double, native_lanes<double>>(true);
     check_memory_lanes<Law, float, native_lanes<float>>(true);
+    check_memory_lanes<Law, double, native_lanes<double>>(true, true);  // the trapezoidal update (fresh stores: batch % 4 == 0)
+    check_memory_lanes<Law, float, native_lanes<float>>(false, true);
     check_memory_lanes<Model<true, true, true, true, true, true, false, true, false>, double, native_lanes<double>>(false);
 }
 

@@ -42,19 +42,21 @@ ContactModel law_named(const std::string& name)
         m.tangential = TangentialModel::linear_history;
         m.kt = 100.0;
         m.tangential_damping_ratio = 0.5;
-    } else {  // mindlin, mindlin_sds: k_t from the material's E and ν
+    } else {  // mindlin, mindlin_sds, mindlin_sds_trapezoidal: k_t from the material's E and ν
         m.tangential = TangentialModel::mindlin;
         m.tangential_damping_ratio = 0.5;
-        if (name == "mindlin_sds") {
+        if (name.starts_with("mindlin_sds")) {
             m.rolling = RollingModel::sds;
             m.kr = 50.0;
             m.rolling_damping = 0.05;
             m.rolling_friction = 0.2;
         }
     }
+    // The trapezoidal stretch update (§9) on every spring there is: its onset rule and the ζ each store keeps.
+    if (name.ends_with("_trapezoidal")) m.stretch_update = StretchUpdate::trapezoidal;
     return m;
 }
-const std::vector<std::string> kLaws = {"linear_history", "mindlin", "mindlin_sds", "tsuji"};
+const std::vector<std::string> kLaws = {"linear_history", "mindlin", "mindlin_sds", "mindlin_sds_trapezoidal", "tsuji"};
 
 struct SearchSetting {
     SearchMethod method;
@@ -208,7 +210,7 @@ TEST_P(MemoryEquivalenceStages, SaveAndContinueIsBitIdenticalToArrays)
 }
 
 INSTANTIATE_TEST_SUITE_P(RegistryTimesLaws, MemoryEquivalenceStages,
-                         ::testing::Combine(::testing::ValuesIn(variant_names()), ::testing::Values("mindlin_sds", "tsuji")), name_of);
+                         ::testing::Combine(::testing::ValuesIn(variant_names()), ::testing::Values("mindlin_sds", "mindlin_sds_trapezoidal", "tsuji")), name_of);
 
 // ---- the full product (ctest label long): both stages × three searches, and save-and-continue under each ----
 

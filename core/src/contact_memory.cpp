@@ -74,6 +74,7 @@ MemoryParams<double> memory_params(const Scene& scene)
     q.shear8_pp = 8.0 / (shear_term(scene.material) + shear_term(scene.material));
     q.shear8_pw = 8.0 / (shear_term(scene.material) + shear_term(scene.wall_mat()));
     q.mindlin = m.tangential == TangentialModel::mindlin;
+    q.trapezoidal = m.stretch_update == StretchUpdate::trapezoidal;
     q.kt = m.kt;
     q.ratio_t = m.tangential_damping_ratio;
     q.kr = m.kr;

@@ -25,6 +25,7 @@ const char* name(TangentialModel t)
     return "viscous";
 }
 const char* name(RollingModel r) { return r == RollingModel::sds ? "sds" : "none"; }
+const char* name(StretchUpdate u) { return u == StretchUpdate::trapezoidal ? "trapezoidal" : "first_order"; }
 
 std::string ContactModel::describe() const
 {
@@ -37,6 +38,7 @@ std::string ContactModel::describe() const
     s += fmt::format(", rolling {}", name(rolling));
     if (rolling == RollingModel::sds)
         s += fmt::format(" (kr = {} N/m, rolling_damping = {} N·s/m, rolling_friction = {})", kr, rolling_damping, rolling_friction);
+    if (stretch_update != StretchUpdate::first_order) s += fmt::format(", stretch update {}", name(stretch_update));
     return s;
 }
 
@@ -52,14 +54,17 @@ std::string ContactModel::toml() const
     o += fmt::format("rolling = \"{}\"\n", name(rolling));
     if (rolling == RollingModel::sds)
         o += fmt::format("kr = {}\nrolling_damping = {}\nrolling_friction = {}\n", kr, rolling_damping, rolling_friction);
+    if (stretch_update != StretchUpdate::first_order) o += fmt::format("stretch_update = \"{}\"\n", name(stretch_update));
     return o;
 }
 
 std::vector<double> ContactModel::fingerprint_values() const
 {
     if (is_paper()) return {};
-    return {double(int(damping)), restitution, double(int(tangential)), kt, tangential_damping_ratio, double(int(rolling)), kr,
-            rolling_damping, rolling_friction};
+    std::vector<double> v{double(int(damping)), restitution, double(int(tangential)), kt, tangential_damping_ratio, double(int(rolling)),
+                          kr, rolling_damping, rolling_friction};
+    if (stretch_update != StretchUpdate::first_order) v.push_back(double(int(stretch_update)));  // older fingerprints unchanged
+    return v;
 }
 
 } // namespace demmat

@@ -234,6 +234,7 @@ Scene chung_ooi_scene(const ChungOoiCase& c)
                 s.contact_model.tangential = TangentialModel::linear_history;
                 s.contact_model.kt = (t.wall() ? q.shear8_pw : q.shear8_pp) * std::sqrt(su.rstar * su.peak_overlap);
             }
+            s.contact_model.stretch_update = c.stretch_update;
         }
     } else {
         throw Error(fmt::format("chung-ooi: unknown law '{}' (expected paper, restitution, linear_history or mindlin)", c.law));

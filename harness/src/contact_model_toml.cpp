@@ -67,7 +67,8 @@ public:
     void close(const ContactModel& m) const
     {
         static const std::set<std::string> known = {"damping", "restitution", "tangential", "kt", "tangential_damping_ratio",
-                                                    "rolling", "kr", "rolling_damping", "rolling_friction"};
+                                                    "rolling", "kr", "rolling_damping", "rolling_friction",
+                                                    "stretch_update"};
         for (const auto& [key, _] : v_.as_table()) {
             if (used_.count(key)) continue;
             if (!known.count(key)) fail(fmt::format("unknown key '{}' in [contact]", printable(key)));
@@ -112,6 +113,7 @@ ContactModel parse_contact_model(const toml::value& v, const std::string& label)
         m.rolling_damping = t.non_negative("rolling_damping", "rolling = \"sds\"");
         m.rolling_friction = t.non_negative("rolling_friction", "rolling = \"sds\"");
     }
+    if (m.has_spring()) m.stretch_update = t.model("stretch_update", {StretchUpdate::first_order, StretchUpdate::trapezoidal});
     t.close(m);
     return m;
 }

@@ -29,16 +29,18 @@ struct MemoryParams {
     T kr{}, gamma_r{}, mu_r{};   // rolling sds: k_r (N/m), γ_r (N·s/m), μ_r
     T dt{};                      // the stretches advance by (velocity)·Δt at each force evaluation
     bool mindlin = false;        // k_t = 8·G*·a (mindlin) instead of the constant kt (linear_history)
+    bool trapezoidal = false;    // the trapezoidal stretch update (physics.md §9) instead of LAMMPS's first-order one
 
     template <class U>
     MemoryParams<U> as() const
     {
-        return {U(alpha), U(kt), U(shear8_pp), U(shear8_pw), U(ratio_t), U(kr), U(gamma_r), U(mu_r), U(dt), mindlin};
+        return {U(alpha), U(kt), U(shear8_pp), U(shear8_pw), U(ratio_t), U(kr), U(gamma_r), U(mu_r), U(dt), mindlin, trapezoidal};
     }
 };
 
 // One contact's memory: the tangential stretch ξ and the rolling stretch ξ_r (metres), zero when the
 // contact starts. Keyed by its pair (lower id, higher id) or (particle id, wall index), never by a slot.
+// Under the trapezoidal update each holds ζ = ξ + (Δt/2)·u, the stretch half a step on (physics.md §9).
 template <class T>
 struct Stretch {
     Vec3<T> t, r;
@@ -125,15 +127,12 @@ DEMMAT_HD inline Vec3<T> to_tangent_plane(const Vec3<T>& xi, const Vec3<T>& n, T
     return select(turn, select(some, turned, Vec3<T>{}), xi);
 }
 
-// §9 steps 1–3 for one spring (tangential or rolling): ξ turned into the plane, advanced by vel·Δt, the
-// trial force −k·ξ − η·vel, capped at `cap` with ξ set back to the stretch of the capped force (the
-// contact slides). Returns the force; `advance` false evaluates without moving the stretch on (t = 0).
+// §9 step 3: the trial force f0 = −k·ξ − η·vel capped at `cap`, ξ set back to the stretch of the capped
+// force where the contact slides (and kept where |ξ| = 0, with no force).
 template <class T, class S>
-DEMMAT_HD inline Vec3<T> spring(Vec3<T>& xi, const Vec3<T>& n, const Vec3<T>& vel, T k, T eta, T cap, S dt, bool advance)
+DEMMAT_HD inline Vec3<T> capped(Vec3<T>& xi, const Vec3<T>& vel, T k, T eta, T cap)
 {
     const T zero{};
-    xi = to_tangent_plane<T, S>(xi, n, k, cap);
-    if (advance) xi = xi + splat<T>(dt) * vel;
     const Vec3<T> f0 = (-k) * xi - eta * vel;
     const T f0_abs = lane_sqrt(dot(f0, f0));
     const auto slides = f0_abs > cap;
@@ -143,6 +142,34 @@ DEMMAT_HD inline Vec3<T> spring(Vec3<T>& xi, const Vec3<T>& n, const Vec3<T>& ve
     const Vec3<T> xi_slid = (-(f + eta * vel)) / k;
     xi = select(slides, select(stretched, xi_slid, xi), xi);
     return select(slides, select(stretched, f, Vec3<T>{}), f0);
+}
+
+// §9 steps 1–3 for one spring (tangential or rolling) under LAMMPS's first-order update: ξ turned into the
+// plane, advanced by vel·Δt, the force capped. Returns the force; `advance` false evaluates without moving
+// the stretch on (t = 0).
+template <class T, class S>
+DEMMAT_HD inline Vec3<T> spring(Vec3<T>& xi, const Vec3<T>& n, const Vec3<T>& vel, T k, T eta, T cap, S dt, bool advance)
+{
+    xi = to_tangent_plane<T, S>(xi, n, k, cap);
+    if (advance) xi = xi + splat<T>(dt) * vel;
+    return capped<T, S>(xi, vel, k, eta, cap);
+}
+
+// The same spring under the trapezoidal update (physics.md §9): the store holds ζ = ξ + (Δt/2)·vel of the
+// last evaluation, so ξ = ζ + (Δt/2)·vel is the trapezoidal rule; a store of exact zeros is a new contact,
+// whose stretch is vel·τ, τ the time since its onset within this step (`onset`).
+template <class T, class S>
+DEMMAT_HD inline Vec3<T> spring_trapezoidal(Vec3<T>& zeta, const Vec3<T>& n, const Vec3<T>& vel, T k, T eta, T cap, S dt, T onset,
+                                            bool advance)
+{
+    const T zero{};
+    const T half = splat<T>(S(0.5) * dt);
+    const auto fresh = (zeta.x == zero) & (zeta.y == zero) & (zeta.z == zero);
+    Vec3<T> xi = to_tangent_plane<T, S>(zeta, n, k, cap);
+    if (advance) xi = xi + (fresh ? onset : half) * vel;
+    const Vec3<T> f = capped<T, S>(xi, vel, k, eta, cap);
+    zeta = advance ? xi + half * vel : xi;
+    return f;
 }
 
 // The §9 law once the geometry is known: normal direction n (from i towards the partner), overlap
@@ -165,16 +192,29 @@ DEMMAT_HD inline void memory_law(const Vec3<T>& n, T h, const Vec3<T>& u, const 
     fn = fn + eta_n * un;
     fn = fn < zero ? zero : fn;  // choice (§2): no attraction; the cap below is μ times this clipped F_n
     const Vec3<T> ut = u - un * n;
+    // The trapezoidal update's onset: the time since h crossed zero along its tangent, τ = h/u_n, where
+    // that lies within this step, else Δt (only a new contact's first evaluation uses it).
+    T onset{};
+    if constexpr (M::history || M::rolling)
+        if (q.trapezoidal) {
+            const T dt = splat<T>(q.dt);
+            const auto within = un * dt > h;
+            onset = within ? h / (within ? un : splat<T>(S(1))) : dt;
+        }
     if constexpr (M::history) {
         const T kt = q.mindlin ? shear8 * a : splat<T>(q.kt);
-        f_t = spring(s.t, n, ut, kt, q.ratio_t * eta_n, p.mu * fn, q.dt, advance);
+        const T eta_t = q.ratio_t * eta_n, cap = p.mu * fn;
+        f_t = q.trapezoidal ? spring_trapezoidal<T, S>(s.t, n, ut, kt, eta_t, cap, q.dt, onset, advance)
+                            : spring<T, S>(s.t, n, ut, kt, eta_t, cap, q.dt, advance);
     } else {
         f_t = viscous_friction(ut, fn, k.ct, p.mu);
     }
     f_i = (-fn) * n + f_t;
     if constexpr (M::rolling) {
         const Vec3<T> vr = (-rstar) * cross(spin, n);  // v_r = −R*·(ω_i − ω_j) × n
-        const Vec3<T> fr = spring(s.r, n, vr, splat<T>(q.kr), splat<T>(q.gamma_r), q.mu_r * fn, q.dt, advance);
+        const T kr = splat<T>(q.kr), gamma_r = splat<T>(q.gamma_r), cap_r = q.mu_r * fn;
+        const Vec3<T> fr = q.trapezoidal ? spring_trapezoidal<T, S>(s.r, n, vr, kr, gamma_r, cap_r, q.dt, onset, advance)
+                                         : spring<T, S>(s.r, n, vr, kr, gamma_r, cap_r, q.dt, advance);
         t_roll = (-rstar) * cross(n, fr);  // T_i += −R*·(n × F_r), T_j −= the same
     }
 }

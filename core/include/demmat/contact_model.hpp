@@ -10,6 +10,9 @@ namespace demmat {
 enum class NormalDamping { viscous, tsuji, restitution };
 enum class TangentialModel { viscous, linear_history, mindlin };
 enum class RollingModel { none, sds };
+// How a spring's stretch advances (physics.md §9): LAMMPS's first-order ξ ← ξ + u·Δt, or the trapezoidal
+// update with the contact's onset placed inside its first step.
+enum class StretchUpdate { first_order, trapezoidal };
 
 struct ContactModel {
     NormalDamping damping = NormalDamping::viscous;  // viscous: the paper's γ_n·m*
@@ -21,6 +24,9 @@ struct ContactModel {
     double kr = 0.0;                                 // N/m, sds
     double rolling_damping = 0.0;                    // γ_r, N·s/m, sds
     double rolling_friction = 0.0;                   // μ_r, sds
+    StretchUpdate stretch_update = StretchUpdate::first_order;  // history and rolling springs
+
+    bool has_spring() const { return tangential != TangentialModel::viscous || rolling != RollingModel::none; }
 
     bool is_paper() const
     {
@@ -37,5 +43,6 @@ struct ContactModel {
 const char* name(NormalDamping d);
 const char* name(TangentialModel t);
 const char* name(RollingModel r);
+const char* name(StretchUpdate u);
 
 } // namespace demmat

@@ -48,6 +48,7 @@ struct ChungOoiCase {
     std::string law = "paper";
     double per_tc = 200.0;
     IntegratorChoice integrator;
+    StretchUpdate stretch_update = StretchUpdate::first_order;  // the history laws' (physics.md §9)
 };
 
 // The case's constants as the scene uses them (also what the study writes beside its measures).
