@@ -44,6 +44,8 @@ SETS = {
     "stability": ("the largest stable Δt", "scripts/run_stability.sh", ["common", "variants/arrays", "bench"]),
     "validation": ("Chung & Ooi tests 1–8", "scripts/run_validation.sh", CODE_ALL + ["analysis/validation_reference.py"]),
     "mpi": ("the mpi variant beside fast and LAMMPS", "scripts/run_mpi_bench.sh", ["common", "variants/mpi", "variants/fast", "app"]),
+    "subnormal": ("what the rule for negligible derivatives saves: settle stage, loose grid beside settled bed",
+                  "scripts/bench_subnormal.sh --before DIR --after DIR", CODE_ALL),
     "gpu": ("the cuda variant on a GPU", "scripts/device_check.sh", ["common", "variants/cuda", "variants/fast", "app"]),
 }
 
