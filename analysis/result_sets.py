@@ -52,6 +52,8 @@ SETS = {
     "stability": ("the largest stable Δt", "scripts/run_stability.sh", CODE_ARRAYS + ["bench"]),
     "validation": ("Chung & Ooi tests 1–8", "scripts/run_validation.sh", CODE_ALL + ["analysis/validation_reference.py"]),
     "mpi": ("the mpi variant beside fast and LAMMPS", "scripts/run_mpi_bench.sh", LANE + ["variants/mpi", "variants/fast", "app"]),
+    "subnormal": ("what the rule for negligible derivatives saves: settle stage, loose grid beside settled bed",
+                  "scripts/bench_subnormal.sh --before DIR --after DIR", CODE_ALL),
     "gpu": ("the cuda variant on a GPU", "scripts/device_check.sh", LANE + ["variants/cuda", "variants/fast", "app"]),
 }
 

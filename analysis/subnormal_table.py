@@ -24,7 +24,7 @@ def read(folder):
     """Tidy rows (part, stage, variant, build, repetition, phase, seconds) and each build's provenance."""
     rows, prov = [], {}
     for path in sorted(folder.glob("*.json")):
-        m = re.fullmatch(r"(settle)_(\w+?)_(before|after)_r(\d+)\.json|bench_(loose|bed)_(before|after)_r(\d+)\.json", path.name)
+        m = re.fullmatch(r"(settle)_(\w+?)_n\d+_(before|after)_r(\d+)\.json|bench_(loose|bed)_n\d+_(before|after)_r(\d+)\.json", path.name)
         if not m:
             continue
         res = results.load(str(path))
@@ -69,21 +69,31 @@ def settle_table(df):
     return lines, int(s.repetition.nunique())
 
 
-def bench_table(df):
-    b = df[df.part == "bench"]
+def bench_table(b):
     n = b.N.iloc[0]
     tot = b.groupby(["stage", "variant", "build", "repetition"])["seconds"].sum() / n * 1e6  # µs per particle-step
     tot = tot.unstack("build")
     med = tot.groupby(level=["stage", "variant"]).median()
     lines = ["| variant | loose without | loose with | loose with/without, paired | bed without | bed with | bed with/without, paired | loose/bed without | loose/bed with |",
              "|---|---:|---:|---:|---:|---:|---:|---:|---:|"]
-    ratios = {st: paired(tot.loc[st]) for st in ("loose", "bed")}
-    for v in med.loc["loose"].index:
-        lo, bd = med.loc["loose"].loc[v], med.loc["bed"].loc[v]
-        rl, rb = ratios["loose"], ratios["bed"]
-        lines.append(f"| {v} | {lo['before']:.3f} | {lo['after']:.3f} | {fmt_ratio(rl[0][v], rl[1][v], rl[2][v])} | "
-                     f"{bd['before']:.3f} | {bd['after']:.3f} | {fmt_ratio(rb[0][v], rb[1][v], rb[2][v])} | "
-                     f"{lo['before'] / bd['before']:.2f} | {lo['after'] / bd['after']:.2f} |")
+    stages = [st for st in ("loose", "bed") if st in med.index.get_level_values("stage")]
+    ratios = {st: paired(tot.loc[st]) for st in stages}
+
+    def cells(st, v):
+        """µs without, µs with, the paired ratio; dashes where the stage was not measured"""
+        if st not in stages or v not in med.loc[st].index:
+            return ["—", "—", "—"], None
+        m, r = med.loc[st].loc[v], ratios[st]
+        return [f"{m['before']:.3f}", f"{m['after']:.3f}", fmt_ratio(r[0][v], r[1][v], r[2][v])], m
+
+    for v in med.index.get_level_values("variant").unique():
+        lo, ml = cells("loose", v)
+        bd, mb = cells("bed", v)
+        if ml is not None and mb is not None:
+            rel = [f"{ml['before'] / mb['before']:.2f}", f"{ml['after'] / mb['after']:.2f}"]
+        else:
+            rel = ["—", "—"]
+        lines.append("| " + " | ".join([v] + lo + bd + rel) + " |")
     return lines, int(n), int(b.repetition.nunique())
 
 
@@ -91,6 +101,8 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("raw", type=pathlib.Path)
     ap.add_argument("-o", "--out", type=pathlib.Path)
+    ap.add_argument("--note", action="append", default=[], help="a line on how this run departed from the script")
+    ap.add_argument("--after-commit", help="the commit whose code a build from a working tree (dirty) was, to name beside it")
     a = ap.parse_args()
     df, prov = read(a.raw)
     out = ["# The rule for negligible derivatives: speed without and with it", "",
@@ -101,16 +113,21 @@ def main():
         if b in prov:
             label = "without the rule" if b == "before" else "with the rule"
             out.append(f"- {label}: {results.provenance_line(prov[b])}")
+            if b == "after" and a.after_commit:
+                out.append(f"  (built from the working tree whose code is that of commit {a.after_commit[:10]})")
     out += ["", "The machine was shared with other builds and runs while these were taken: read the paired ratios,",
-            "not the absolute times.", ""]
+            "not the absolute times.", ""] + [f"Note: {n}" for n in a.note] + ([""] if a.note else [])
     if (df.part == "settle").any():
         lines, reps = settle_table(df)
         n = int(df[df.part == "settle"].N.iloc[0])
         out += [f"## The main job's settle stage: the dense bed of {n} grains for 0.4 s from its loose grid ({reps} repetitions)", ""]
         out += lines + [""]
-    if (df.part == "bench").any():
-        lines, n, reps = bench_table(df)
-        out += [f"## Every variant: µs per particle-step, loose grid (t = 0) and settled bed, N = {n} ({reps} repetitions)", ""]
+    bench = df[df.part == "bench"]
+    for n in sorted(bench.N.unique()):
+        lines, n, reps = bench_table(bench[bench.N == n])
+        steps = max(200, -(-1000000 // n))
+        out += [f"## Every variant: µs per particle-step, loose grid (t = 0) and settled bed, N = {n} ({reps} repetitions)", "",
+                f"{steps} timed steps after 20 untimed, from the loose grid at t = 0 and from the bed settled for 0.4 s by the same build.", ""]
         out += lines + [""]
     emit("\n".join(out), a.out)
 

@@ -98,8 +98,8 @@ class Loader(unittest.TestCase):
                     if stage == "loose":
                         for x in after["samples"]:
                             x["seconds_per_step"] *= factor
-                    json.dump(raw, open(os.path.join(work, f"bench_{stage}_before_r{r}.json"), "w"))
-                    json.dump(after, open(os.path.join(work, f"bench_{stage}_after_r{r}.json"), "w"))
+                    json.dump(raw, open(os.path.join(work, f"bench_{stage}_n2000_before_r{r}.json"), "w"))
+                    json.dump(after, open(os.path.join(work, f"bench_{stage}_n2000_after_r{r}.json"), "w"))
             out = os.path.join(work, "subnormal.md")
             subprocess.run([sys.executable, os.path.join(ANALYSIS, "subnormal_table.py"), work, "-o", out], check=True,
                            stdout=subprocess.DEVNULL)
