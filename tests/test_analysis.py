@@ -85,6 +85,31 @@ class Loader(unittest.TestCase):
         self.assertEqual(fast["sample"].nunique(), 4)  # 2 configurations × 2 repetitions
         self.assertEqual(len(results.wide(r.table)), 6)
 
+    def test_subnormal_table_pairs_the_builds_within_each_repetition(self):
+        # the bench sample as the loose grid and the bed, without the rule; with it, the loose grid at
+        # half the time in repetition 0 and a quarter in repetition 1, the bed unchanged
+        import json
+        raw = json.load(open(os.path.join(DATA, "bench_sample.json")))
+        work = tempfile.mkdtemp()
+        try:
+            for r, factor in ((0, 0.5), (1, 0.25)):
+                for stage in ("loose", "bed"):
+                    after = json.loads(json.dumps(raw))
+                    if stage == "loose":
+                        for x in after["samples"]:
+                            x["seconds_per_step"] *= factor
+                    json.dump(raw, open(os.path.join(work, f"bench_{stage}_before_r{r}.json"), "w"))
+                    json.dump(after, open(os.path.join(work, f"bench_{stage}_after_r{r}.json"), "w"))
+            out = os.path.join(work, "subnormal.md")
+            subprocess.run([sys.executable, os.path.join(ANALYSIS, "subnormal_table.py"), work, "-o", out], check=True,
+                           stdout=subprocess.DEVNULL)
+            row = next(l for l in open(out) if l.startswith("| arrays |")).split("|")
+            self.assertEqual(row[4].strip(), "0.375 (0.250–0.500)")  # loose: paired, median of 0.5 and 0.25
+            self.assertEqual(row[7].strip(), "1.000 (1.000–1.000)")  # bed
+            self.assertAlmostEqual(float(row[8]) / float(row[9]), 1 / 0.375, delta=0.05)  # loose/bed without over with (printed to 2 places)
+        finally:
+            shutil.rmtree(work)
+
     @staticmethod
     def summarise_fast(raw):
         """summarise_fast.py's summary of one bench JSON, as the settled bed of 2000."""

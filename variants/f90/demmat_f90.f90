@@ -31,14 +31,14 @@ module demmat_f90_kernels
       real(dp), intent(in) :: b5(n, 3)
       real(dp), intent(in) :: dt, half_dt2, two_over_dt2
     end subroutine gear_predictor
-    subroutine gear_corrector(n, x, v, a, b3, b4, b5, a_new, cx, cv, c3, c4, c5)
+    subroutine gear_corrector(n, x, v, a, b3, b4, b5, a_new, cx, cv, c3, c4, c5, negligible)
       use, intrinsic :: iso_c_binding
       implicit none
       integer, parameter :: dp = c_double
       integer, intent(in) :: n
       real(dp), intent(inout) :: x(n, 3), v(n, 3), a(n, 3), b3(n, 3), b4(n, 3), b5(n, 3)
       real(dp), intent(in) :: a_new(n, 3)
-      real(dp), intent(in) :: cx, cv, c3, c4, c5
+      real(dp), intent(in) :: cx, cv, c3, c4, c5, negligible
     end subroutine gear_corrector
     pure function cross(a, b) result(c)
       use, intrinsic :: iso_c_binding
@@ -98,7 +98,7 @@ module demmat_f90
     integer :: n = 0, nw = 0, cap = 0, wcap = 0
     real(dp) :: cell = 0.0_dp
     ! Gear coefficients and contact parameters (from C++)
-    real(dp) :: dt, half_dt2, two_over_dt2, cx, cv, c3, c4, c5
+    real(dp) :: dt, half_dt2, two_over_dt2, cx, cv, c3, c4, c5, negligible
     real(dp) :: hertz_pp, hertz_pw, gamma_n, gamma_t, mu, margin
     real(dp) :: g(3)
     ! state, (N, 3) each
@@ -310,19 +310,20 @@ contains
   end subroutine f90_destroy
 
   ! gear: 12 arrays (x, v, a, b3, b4, b5, th, w, al, r3, r4, r5), each (N, 3) column-major, in `gear`.
-  ! coef: dt, half_dt2, two_over_dt2, cx, cv, c3, c4, c5; contact: hertz_pp, hertz_pw, gamma_n, gamma_t, mu, may_touch margin.
+  ! coef: dt, half_dt2, two_over_dt2, cx, cv, c3, c4, c5, the negligible-derivative bound (gear.hpp); contact: hertz_pp, hertz_pw, gamma_n, gamma_t, mu, may_touch margin.
   subroutine f90_init(h, n, nw, cap, wcap, cell, radius, mass, inertia, gear, wn, wv, grav, coef, contact) &
       bind(C, name="demmat_f90_init")
     type(c_ptr), value :: h
     integer(c_int), value :: n, nw, cap, wcap
     real(c_double), value :: cell
     real(c_double), intent(in) :: radius(n), mass(n), inertia(n), gear(n, 3, 12), wn(3, nw), wv(3, nw)
-    real(c_double), intent(in) :: grav(3), coef(8), contact(6)
+    real(c_double), intent(in) :: grav(3), coef(9), contact(6)
     type(processor), pointer :: p
     p => get(h)
     p%n = n; p%nw = nw; p%cap = cap; p%wcap = wcap; p%cell = cell
     p%dt = coef(1); p%half_dt2 = coef(2); p%two_over_dt2 = coef(3)
     p%cx = coef(4); p%cv = coef(5); p%c3 = coef(6); p%c4 = coef(7); p%c5 = coef(8)
+    p%negligible = coef(9)
     p%hertz_pp = contact(1); p%hertz_pw = contact(2); p%gamma_n = contact(3); p%gamma_t = contact(4); p%mu = contact(5)
     p%margin = contact(6)
     p%g = grav
@@ -413,8 +414,8 @@ contains
     type(c_ptr), value :: h
     type(processor), pointer :: p
     p => get(h)
-    call gear_corrector(p%n, p%x, p%v, p%a, p%b3, p%b4, p%b5, p%acc, p%cx, p%cv, p%c3, p%c4, p%c5)
-    call gear_corrector(p%n, p%th, p%w, p%al, p%r3, p%r4, p%r5, p%alc, p%cx, p%cv, p%c3, p%c4, p%c5)
+    call gear_corrector(p%n, p%x, p%v, p%a, p%b3, p%b4, p%b5, p%acc, p%cx, p%cv, p%c3, p%c4, p%c5, p%negligible)
+    call gear_corrector(p%n, p%th, p%w, p%al, p%r3, p%r4, p%r5, p%alc, p%cx, p%cv, p%c3, p%c4, p%c5, p%negligible)
   end subroutine f90_correct
 
   ! which: 1..12 the Gear arrays (x, v, a, b3, b4, b5, th, w, al, r3, r4, r5), 13 force, 14 torque.
@@ -491,14 +492,16 @@ subroutine gear_predictor(n, x, v, a, b3, b4, b5, dt, half_dt2, two_over_dt2)
   end do
 end subroutine gear_predictor
 
-subroutine gear_corrector(n, x, v, a, b3, b4, b5, a_new, cx, cv, c3, c4, c5)
+! Ends with the rule for negligible derivatives (physics.md §3): a, b3, b4, b5 below the bound in
+! magnitude become +0 (abs(u) < bound is -bound < u < bound, as gear.hpp compares).
+subroutine gear_corrector(n, x, v, a, b3, b4, b5, a_new, cx, cv, c3, c4, c5, negligible)
   use, intrinsic :: iso_c_binding
   implicit none
   integer, parameter :: dp = c_double
   integer, intent(in) :: n
   real(dp), intent(inout) :: x(n, 3), v(n, 3), a(n, 3), b3(n, 3), b4(n, 3), b5(n, 3)
   real(dp), intent(in) :: a_new(n, 3)
-  real(dp), intent(in) :: cx, cv, c3, c4, c5
+  real(dp), intent(in) :: cx, cv, c3, c4, c5, negligible
   integer :: i, c
   real(dp) :: da
   do c = 1, 3
@@ -510,6 +513,10 @@ subroutine gear_corrector(n, x, v, a, b3, b4, b5, a_new, cx, cv, c3, c4, c5)
       b3(i, c) = b3(i, c) + c3*da
       b4(i, c) = b4(i, c) + c4*da
       b5(i, c) = b5(i, c) + c5*da
+      if (abs(a(i, c)) < negligible) a(i, c) = 0.0_dp
+      if (abs(b3(i, c)) < negligible) b3(i, c) = 0.0_dp
+      if (abs(b4(i, c)) < negligible) b4(i, c) = 0.0_dp
+      if (abs(b5(i, c)) < negligible) b5(i, c) = 0.0_dp
     end do
   end do
 end subroutine gear_corrector

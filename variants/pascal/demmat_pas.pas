@@ -44,7 +44,7 @@ type
     used: Boolean;
     n, nw, cap, wcap, pcap, pwcap: LongInt;
     cell, margin: Double;
-    dt, half_dt2, two_over_dt2, cx, cv, c3, c4, c5: Double;
+    dt, half_dt2, two_over_dt2, cx, cv, c3, c4, c5, negligible: Double;
     hertz_pp, hertz_pw, gamma_n, gamma_t, mu: Double;
     g: array[0..2] of Double;
     x, v, a, b3, b4, b5, th, w, al, r3, r4, r5, f, t, acc, alc: TDArr;
@@ -88,7 +88,10 @@ begin
   end;
 end;
 
-procedure GearCorrector(n: LongInt; var x, v, a, b3, b4, b5: TDArr; const a_new: TDArr; cx, cv, c3, c4, c5: Double);
+{ Ends with the rule for negligible derivatives (physics.md §3): a, b3, b4, b5 below the bound in
+  magnitude become +0 (Abs(u) < bound is -bound < u < bound, as gear.hpp compares). }
+procedure GearCorrector(n: LongInt; var x, v, a, b3, b4, b5: TDArr; const a_new: TDArr;
+  cx, cv, c3, c4, c5, negligible: Double);
 var k: LongInt; da: Double;
 begin
   for k := 0 to 3 * n - 1 do
@@ -100,6 +103,10 @@ begin
     b3[k] := b3[k] + c3 * da;
     b4[k] := b4[k] + c4 * da;
     b5[k] := b5[k] + c5 * da;
+    if Abs(a[k]) < negligible then a[k] := ZERO;
+    if Abs(b3[k]) < negligible then b3[k] := ZERO;
+    if Abs(b4[k]) < negligible then b4[k] := ZERO;
+    if Abs(b5[k]) < negligible then b5[k] := ZERO;
   end;
 end;
 
@@ -418,7 +425,7 @@ begin
 end;
 
 { gear: 12 arrays (x, v, a, b3, b4, b5, th, w, al, r3, r4, r5), each (N, 3) column-major.
-  coef: dt, half_dt2, two_over_dt2, cx, cv, c3, c4, c5.
+  coef: dt, half_dt2, two_over_dt2, cx, cv, c3, c4, c5, the negligible-derivative bound (gear.hpp).
   contact: hertz_pp, hertz_pw, gamma_n, gamma_t, mu, may_touch margin (1.000000001). }
 procedure demmat_pas_init(h, an, anw, acap, awcap: LongInt; acell: Double; radius, mass, inertia, gear, awn, awv,
   grav, coef, contact: PDouble); cdecl;
@@ -432,6 +439,7 @@ begin
   if awcap > 1 then p^.pwcap := awcap else p^.pwcap := 1;
   p^.dt := coef[0]; p^.half_dt2 := coef[1]; p^.two_over_dt2 := coef[2];
   p^.cx := coef[3]; p^.cv := coef[4]; p^.c3 := coef[5]; p^.c4 := coef[6]; p^.c5 := coef[7];
+  p^.negligible := coef[8];
   p^.hertz_pp := contact[0]; p^.hertz_pw := contact[1]; p^.gamma_n := contact[2]; p^.gamma_t := contact[3];
   p^.mu := contact[4]; p^.margin := contact[5];
   p^.g[0] := grav[0]; p^.g[1] := grav[1]; p^.g[2] := grav[2];
@@ -526,8 +534,8 @@ begin
   saved := EnterFP;
   with Slots[h] do
   begin
-    GearCorrector(n, x, v, a, b3, b4, b5, acc, cx, cv, c3, c4, c5);
-    GearCorrector(n, th, w, al, r3, r4, r5, alc, cx, cv, c3, c4, c5);
+    GearCorrector(n, x, v, a, b3, b4, b5, acc, cx, cv, c3, c4, c5, negligible);
+    GearCorrector(n, th, w, al, r3, r4, r5, alc, cx, cv, c3, c4, c5, negligible);
   end;
   LeaveFP(saved);
 end;

@@ -3,7 +3,9 @@
 // type whose predict/correct are templates on the value type V, exactly like gear.hpp: a variant calls
 // them on one double, one float, or a whole Eigen array. Every scheme works on the same six values per
 // degree of freedom (x, v, a, b3, b4, b5) so that one state layout and one state file serve them all;
-// a scheme leaves the values it does not use untouched (zero from the initial state).
+// a scheme leaves the values it does not use untouched (zero from the initial state). Every scheme ends
+// its corrector with the rule for negligible derivatives (gear.hpp) on the derivatives it carries: a,
+// b3, b4, b5 for gear5; a, b3 for gear3; a for verlet and symplectic_euler.
 //
 // The step keeps the paper's phases for every scheme: predict → search → forces (at the predicted
 // positions and velocities) → correct with the new acceleration a_new = F/m + g.
@@ -120,6 +122,8 @@ struct Gear3Scheme {
         v = v + k.cv * da;
         a = a + da;
         b3 = b3 + k.c3 * da;
+        zero_if_negligible(a);
+        zero_if_negligible(b3);
     }
 };
 
@@ -167,6 +171,7 @@ struct VerletScheme {
         else
             v = v + k.half_dt * (a_new - a);
         a = a_new;
+        zero_if_negligible(a);
     }
 };
 
@@ -193,6 +198,7 @@ struct SymplecticEulerScheme {
     static void correct(V&, V&, V& a, V&, V&, V&, const D& a_new, const EulerCoefficients<T>&)
     {
         a = a_new;
+        zero_if_negligible(a);
     }
 };
 

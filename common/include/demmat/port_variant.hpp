@@ -18,7 +18,7 @@ namespace demmat {
 // The entry points of a port. init receives: n, walls, the two capacities, the cell edge (0: every
 // pair), radius, mass, inertia (N each), the 12 Gear arrays as (N, 3, 12) column-major, wall normals and
 // velocities (3 per wall), gravity (3), the Gear coefficients (dt, dt²/2, 2/dt², c0·dt²/2, c1·dt/2,
-// c3·dt²/2, c4·dt²/2, c5·dt²/2) and the contact constants (hertz_pp, hertz_pw, γn, γt, μ, may_touch's
+// c3·dt²/2, c4·dt²/2, c5·dt²/2, and the bound of the rule for negligible derivatives, gear.hpp) and the contact constants (hertz_pp, hertz_pw, γn, γt, μ, may_touch's
 // margin). search reports status 0 (ok), 1 (pair capacity: info = the value that fits), 2 (wall
 // capacity) or 3 (a runaway position), with the particle. get(which) writes an (N, 3) array: 1–12 the
 // Gear arrays in State order, 13 force, 14 torque. counts writes particle–particle, particle–wall,
@@ -76,7 +76,7 @@ public:
                 wv[3 * w + c] = component(walls_[w].velocity, c);
             }
         const GearCoefficients<double>& k = setup.gear;
-        const double coef[8] = {k.dt, k.half_dt2, k.two_over_dt2, k.cx, k.cv, k.c3, k.c4, k.c5};
+        const double coef[9] = {k.dt, k.half_dt2, k.two_over_dt2, k.cx, k.cv, k.c3, k.c4, k.c5, negligible_derivative<double>()};
         const ContactParams<double>& p = setup.contact;
         // The last entry is may_touch's margin, passed as a double so no port parses a decimal literal.
         const double contact[6] = {p.hertz_pp, p.hertz_pw, p.gamma_n, p.gamma_t, p.mu, kMayTouchMargin};
