@@ -38,7 +38,7 @@ SETS = {
                    LANE + ["variants/fast", "app", "peers"]),
     "peers_fast_xeon": ("fast beside LAMMPS built for the CPU and Debian's binary, one core and two: fast's targets; second CPU",
                         "OMP_WAIT_POLICY=PASSIVE scripts/run_peers.sh --bench-only --no-liggghts --variants fast,fast_unordered "
-                        "--n \"1000 4000 16000\" --threads \"1 2\" --repetitions 5 --out results/peers_fast_xeon",
+                        "--n \"1000 4000 16000\" --threads \"1 2\" --repetitions 3 --out results/peers_fast_xeon",
                         LANE + ["variants/fast", "app", "peers", "scripts/build_lammps.sh"]),
     "peers_mindlin": ("fast and arrays beside LAMMPS with mindlin", "scripts/run_peers.sh --contact … --out results/peers_mindlin",
                       LANE + ["variants/fast", "variants/arrays", "app", "peers"]),
