@@ -105,6 +105,8 @@ if [[ " $parts " == *" bench "* ]]; then
   done
 fi
 (( ${#pids[@]} == 0 )) || wait "${pids[@]}"
+# The scenes lived in a temporary folder: the results name them by file name alone.
+sed -i "s#$work/##g" "$raw"/*.json
 
 $PYTHON analysis/subnormal_table.py "$raw" -o "$outdir/subnormal.md"
 echo "$outdir/subnormal.md"
