@@ -7,6 +7,7 @@
 #include "demmat/contact_memory.hpp"
 #include "demmat/error.hpp"
 #include "demmat/model.hpp"
+#include "demmat/scene_toml.hpp"
 
 using namespace demmat;
 
